@@ -1,0 +1,87 @@
+// The reference TRM decoder in double precision (DESIGN §4, paper Eqs. 1-7). The fixed-point decoders
+// are held to it.
+#pragma once
+
+#include "trm/encoder.hpp"
+#include "trm/frame.hpp"
+#include "trm/panel.hpp"
+
+#include <cstdint>
+#include <map>
+#include <optional>
+
+namespace trm {
+
+struct DecoderConfig {
+  EncoderConfig link;          // r, sigma, transfer, bits, resample space: must match the encoder
+  double sensitivity = 10.0;   // s in w = exp(-s c) (Eq. 6); s >= 0 (+inf allowed: residual only where c = 0)
+  Panel panel;                 // OLED or LCD inverse
+  int output_bits = 8;         // drive code depth, 8 or 10
+  bool record_stages = false;  // fill DecodedFrame::stages (per-stage vectors for golden tests)
+
+  void validate() const;       // throws std::invalid_argument with a clear message
+};
+
+struct FrameStats {
+  double clipped_fraction = 0.0;       // full frame: fraction of channel samples with beta outside [0, 1];
+                                       // reduced frame: fraction with alpha + w rho outside [0, 1]
+  double residual_mean_abs = 0.0;      // |rho| after this frame (full frames) / of the rho consumed (reduced)
+  double residual_max_abs = 0.0;
+  double dropped_sum = 0.0;            // reduced frame: sum over samples of what alpha' clipping dropped
+  double mean_motion_weight = 1.0;     // reduced frame: mean w
+  bool residual_applied = false;       // reduced frame: a residual from a preceding full frame was used
+  double lcd_unreachable_fraction = 0.0;
+};
+
+// Per-stage intermediates of one decoded frame (DESIGN §4 notation). Matrices that do not apply to the frame
+// (or to the panel) are left empty. Full-size values are CV_64FC3 unless noted.
+struct DecodeStages {
+  cv::Mat low_codes;            // full: d_t = Q_b(D(E_t)); reduced: i_t as received (CV_16UC3, reduced size)
+  cv::Mat low_linear;           // full: L_t = lin(U(d_t)); reduced: alpha = lin(U(i_t))
+  cv::Mat full_linear;          // full: I_t = lin(E_t)
+  cv::Mat beta;                 // full: beta = 2 I_t - L_t before clamping (Eq. 2)
+  cv::Mat residual;             // full: rho_t after this frame, LCD shortfall included; reduced: the rho consumed
+  cv::Mat previous_low_linear;  // reduced with residual: L_prev = lin(U(d_{t-1}))
+  cv::Mat contrast;             // reduced with residual: c (Eq. 5), CV_64FC1
+  cv::Mat weight;               // reduced with residual: w = exp(-s c) (Eq. 6), CV_64FC1
+  cv::Mat alpha_unclamped;      // reduced with residual: alpha + w rho (Eq. 4) before clamping
+  cv::Mat lcd_target;           // LCD: target merged value m = ((x_t + x_{t-1}) / 2)^(1/gamma)
+  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} the merge was solved against (quantised drive, as a value)
+  cv::Mat lcd_unreachable;      // LCD: 255 where M(v, v_{t-1}) = m had no root in [0, 1] (CV_8UC3)
+};
+
+struct DecodedFrame {
+  FrameMeta meta;          // as received, except width/height: the full size of the decoded view
+  cv::Mat wanted_linear;   // full: clamp(beta); reduced: alpha' (CV_64FC3, full size)
+  cv::Mat drive;           // panel drive v in [0, 1] before output quantisation (CV_64FC3)
+  cv::Mat drive_codes;     // floor(v (2^output_bits - 1) + 0.5) (CV_16UC3)
+  cv::Mat emitted_linear;  // linear light the panel emits in this frame from the quantised drive;
+                           // LCD: the merged value of (v_t, v_{t-1}) raised to gamma
+  FrameStats stats;
+  std::optional<DecodeStages> stages;  // when DecoderConfig::record_stages
+};
+
+class ReferenceDecoder {
+ public:
+  explicit ReferenceDecoder(DecoderConfig config);
+  const DecoderConfig& config() const { return config_; }
+  // Decodes one view; each eye keeps its own residual / previous-frame state. Throws std::invalid_argument
+  // when the frame does not match the configuration (bits, transfer, size, codes out of range). A reduced
+  // frame uses the residual only when the eye's previous frame was the full frame with index t - 1.
+  DecodedFrame decode(const LinkFrame& frame);
+
+ private:
+  struct EyeState {
+    cv::Size full_size;        // the view size the state belongs to; a change of size starts afresh
+    bool have_residual = false;
+    std::int64_t residual_index = 0;  // index t of the full frame the residual comes from
+    cv::Mat residual;          // rho_t, full size, signed
+    cv::Mat previous_low;      // d_t = Q_b(D(E_t)) codes, reduced size, for the motion test
+    cv::Mat previous_drive;    // LCD: v_{t-1} actually shown (quantised drive as a value in [0, 1])
+    cv::Mat previous_wanted;   // LCD: x_{t-1}
+  };
+  DecoderConfig config_;
+  std::map<int, EyeState> eyes_;
+};
+
+}  // namespace trm

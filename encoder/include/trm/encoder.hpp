@@ -1,0 +1,42 @@
+// The GPU-side TRM encoder (DESIGN §3-4): per frame parity, a full frame or a reduced frame.
+#pragma once
+
+#include "trm/frame.hpp"
+
+#include <vector>
+
+namespace trm {
+
+struct EncoderConfig {
+  double reduction = 0.5;      // r in (0, 1]
+  double sigma = 0.0;          // <= 0 means default_sigma(r); a user-given sigma must be > 0
+  int phase = 0;               // 0: even t full, odd t reduced; 1: swapped
+  Transfer transfer = Transfer::Srgb;
+  ResampleSpace resample_space = ResampleSpace::Encoded;
+  int bits = 8;                // link bits, 8 or 10
+  bool stereo = false;         // two eyes off-phase: every link frame carries one full and one reduced view
+
+  double effective_sigma() const;
+  // Throws std::invalid_argument with a clear message for r outside (0, 1], sigma <= 0 when given,
+  // bits other than 8/10, phase other than 0/1.
+  void validate() const;
+};
+
+Parity parity_of(std::int64_t t, int eye, const EncoderConfig& config);
+
+// The reduced frame the encoder sends for an encoded, quantised full frame: Q_b(D(E)), with D in the
+// configured resample space. Shared with the decoder, which recomputes d_t = Q_b(D(E_t)) from the full frame.
+cv::Mat reduce_codes(const cv::Mat& full_codes, const EncoderConfig& config);
+
+class TrmEncoder {
+ public:
+  explicit TrmEncoder(EncoderConfig config);
+  const EncoderConfig& config() const { return config_; }
+  // Encodes linear frame t of one eye (CV_64FC3 in [0, 1]) into the view the link carries.
+  LinkFrame encode(const cv::Mat& linear_full, std::int64_t t, int eye = 0) const;
+
+ private:
+  EncoderConfig config_;
+};
+
+}  // namespace trm

@@ -1,0 +1,46 @@
+// Plain value types that cross module boundaries: link frames and their metadata.
+//
+// Images are cv::Mat with channels in RGB order (never BGR): image I/O converts at the edge.
+//   linear / encoded values: CV_64FC3 (or CV_64FC1), normalised to [0, 1]
+//   link codes and drive codes: CV_16UC3, q = floor(x * (2^bits - 1) + 0.5)
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace trm {
+
+enum class Parity : std::uint8_t { Full = 0, Reduced = 1 };
+
+enum class Transfer : std::uint8_t { Srgb = 0, Gamma22 = 1 };
+
+// Space in which D and U act (DESIGN §3): encoded values (default, paper Sec. 4.2) or linear.
+enum class ResampleSpace : std::uint8_t { Encoded = 0, Linear = 1 };
+
+const char* to_string(Parity p);
+const char* to_string(Transfer t);
+const char* to_string(ResampleSpace s);
+Transfer parse_transfer(const std::string& name);            // "srgb" | "gamma2.2"; throws std::invalid_argument
+ResampleSpace parse_resample_space(const std::string& name);  // "encoded" | "linear"
+
+struct FrameMeta {
+  std::int64_t index = 0;    // t = 0, 1, 2, ...
+  int eye = 0;               // 0 = left (or mono), 1 = right
+  Parity parity = Parity::Full;
+  int width = 0;             // size of this frame as sent (reduced size for reduced frames)
+  int height = 0;
+  int full_width = 0;        // size of the full-resolution view it reconstructs to
+  int full_height = 0;
+  int bits = 8;              // link bits per channel (8 or 10)
+  Transfer transfer = Transfer::Srgb;
+};
+
+// One view of one link frame: encoded, quantised codes (CV_16UC3, RGB).
+struct LinkFrame {
+  FrameMeta meta;
+  cv::Mat codes;
+};
+
+}  // namespace trm

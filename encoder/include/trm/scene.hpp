@@ -1,0 +1,60 @@
+// Frame sources: analytic scenes (anti-aliased by supersampling, each knowing its own motion)
+// and real inputs (image sequences, video files).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace trm {
+
+struct SceneParams {
+  int width = 1080;            // full-resolution view size
+  int height = 1200;
+  double refresh_hz = 90.0;
+  std::uint64_t seed = 1;      // for scenes with randomness (jitter, procedural texture)
+  std::string image_path;      // panorama / static: optional image to use instead of the procedural texture
+  int supersample = 4;         // samples per axis per pixel for analytic anti-aliasing
+};
+
+// Motion of the content at one frame, in full-resolution pixels per second, for the eye model:
+// a global velocity (panning, jitter) or per-object velocities with their bounding boxes.
+struct MotionObject {
+  cv::Rect2d bounds;           // pixels, at this frame
+  cv::Vec2d velocity_px_s;
+};
+struct Motion {
+  cv::Vec2d global_velocity_px_s{0.0, 0.0};
+  std::vector<MotionObject> objects;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual std::string name() const = 0;
+  virtual int width() const = 0;
+  virtual int height() const = 0;
+  // Number of frames available, or nullopt for an endless analytic scene.
+  virtual std::optional<std::int64_t> frame_count() const = 0;
+  // Linear-light RGB frame t (CV_64FC3, values in [0, 1]); throws std::runtime_error on a read failure
+  // and std::invalid_argument on NaN/Inf/negative/out-of-range content.
+  virtual cv::Mat linear_frame(std::int64_t t) = 0;
+  virtual Motion motion(std::int64_t t) const = 0;
+};
+
+// Names: discs, text, panorama, line, zoneplate, checker, flash, static, jitter.
+std::vector<std::string> scene_names();
+// Throws std::invalid_argument naming the valid scenes when name is unknown.
+std::unique_ptr<FrameSource> make_scene(const std::string& name, const SceneParams& params);
+
+// Image sequence: a glob such as 'DIR/frame_*.png' (sorted by name), 8- or 16-bit PNG (or any format
+// OpenCV reads), sRGB-encoded. Validates up front: at least one file, all readable images, same size.
+// Throws std::runtime_error with a message naming the offending file.
+std::unique_ptr<FrameSource> open_image_sequence(const std::string& pattern);
+// Video file through OpenCV (sRGB-encoded 8-bit frames).
+std::unique_ptr<FrameSource> open_video(const std::string& path);
+
+}  // namespace trm

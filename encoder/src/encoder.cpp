@@ -1,0 +1,83 @@
+// The GPU-side TRM encoder (DESIGN §3-4, paper Sec. 4 and Fig. 4).
+#include "trm/encoder.hpp"
+
+#include "trm/resample.hpp"
+#include "trm/transfer.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace trm {
+
+double EncoderConfig::effective_sigma() const { return sigma > 0.0 ? sigma : default_sigma(reduction); }
+
+void EncoderConfig::validate() const {
+  if (!(reduction > 0.0 && reduction <= 1.0)) {
+    throw std::invalid_argument("reduction r must be in (0, 1], got " + std::to_string(reduction));
+  }
+  // sigma == 0 selects the default; a user-given sigma must be a positive finite number.
+  if (std::isnan(sigma) || sigma < 0.0 || !std::isfinite(sigma)) {
+    throw std::invalid_argument("sigma must be > 0 when given (0 selects 1.25 / r), got " + std::to_string(sigma));
+  }
+  if (bits != 8 && bits != 10) throw std::invalid_argument("link bits must be 8 or 10, got " + std::to_string(bits));
+  if (phase != 0 && phase != 1) throw std::invalid_argument("phase must be 0 or 1, got " + std::to_string(phase));
+  if (transfer != Transfer::Srgb && transfer != Transfer::Gamma22) throw std::invalid_argument("unknown transfer function");
+  if (resample_space != ResampleSpace::Encoded && resample_space != ResampleSpace::Linear) {
+    throw std::invalid_argument("unknown resample space");
+  }
+}
+
+Parity parity_of(std::int64_t t, int eye, const EncoderConfig& config) {
+  if (t < 0) throw std::invalid_argument("frame index must be >= 0, got " + std::to_string(t));
+  if (eye != 0 && eye != 1) throw std::invalid_argument("eye must be 0 or 1, got " + std::to_string(eye));
+  // Even t full by default; --phase swaps. In stereo the right eye is off-phase so that every link frame
+  // carries one full and one reduced view (poster: binocular off-phase).
+  int odd = static_cast<int>(t % 2) ^ config.phase;
+  if (config.stereo && eye == 1) odd ^= 1;
+  return odd ? Parity::Reduced : Parity::Full;
+}
+
+cv::Mat reduce_codes(const cv::Mat& full_codes, const EncoderConfig& config) {
+  config.validate();
+  if (full_codes.depth() != CV_16U || full_codes.empty()) {
+    throw std::invalid_argument("reduce_codes: expected non-empty CV_16U link codes");
+  }
+  const int w = reduced_size(full_codes.cols, config.reduction);
+  const int h = reduced_size(full_codes.rows, config.reduction);
+  const double sigma = config.effective_sigma();
+  const cv::Mat encoded = dequantise(full_codes, config.bits);
+  if (config.resample_space == ResampleSpace::Encoded) {
+    return quantise(downsample(encoded, w, h, sigma), config.bits);  // Q_b(D(E))
+  }
+  const cv::Mat linear_reduced = downsample(to_linear(encoded, config.transfer), w, h, sigma);
+  return quantise(to_encoded(linear_reduced, config.transfer), config.bits);  // Q_b(enc(D(lin(E))))
+}
+
+TrmEncoder::TrmEncoder(EncoderConfig config) : config_(config) { config_.validate(); }
+
+LinkFrame TrmEncoder::encode(const cv::Mat& linear_full, std::int64_t t, int eye) const {
+  if (linear_full.type() != CV_64FC3 || linear_full.empty()) {
+    throw std::invalid_argument("encode: expected a non-empty CV_64FC3 linear RGB frame");
+  }
+  if (!cv::checkRange(linear_full, true, nullptr, 0.0, 1.0 + 1e-12)) {
+    throw std::invalid_argument("encode: frame " + std::to_string(t) + " has NaN, Inf or values outside [0, 1]");
+  }
+  LinkFrame frame;
+  frame.meta.index = t;
+  frame.meta.eye = eye;
+  frame.meta.parity = parity_of(t, eye, config_);
+  frame.meta.full_width = linear_full.cols;
+  frame.meta.full_height = linear_full.rows;
+  frame.meta.bits = config_.bits;
+  frame.meta.transfer = config_.transfer;
+
+  // What the GPU would send at full resolution; a reduced frame is derived from exactly these codes.
+  cv::Mat full_codes = quantise(to_encoded(linear_full, config_.transfer), config_.bits);
+  frame.codes = frame.meta.parity == Parity::Full ? full_codes : reduce_codes(full_codes, config_);
+  frame.meta.width = frame.codes.cols;
+  frame.meta.height = frame.codes.rows;
+  return frame;
+}
+
+}  // namespace trm

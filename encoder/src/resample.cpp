@@ -1,0 +1,215 @@
+// D (polyphase Gaussian decimator) and U (bilinear upsampler), DESIGN §3.
+//
+// All sample positions are derived from integers. A reduced sample x_low along an axis of full size W
+// and reduced size w sits at c = ((2 x_low + 1) W - w) / (2 w) in full-resolution pixel coordinates;
+// a full pixel x maps to x_low = ((2x + 1) w - W) / (2 W) in reduced coordinates. Keeping the
+// numerators as integers makes tap membership (|i - c| <= R) and integer centres exact.
+#include "trm/resample.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace trm {
+namespace {
+
+// Floor division for a positive divisor (C++ '/' truncates towards zero).
+std::int64_t floor_div(std::int64_t num, std::int64_t den) {
+  std::int64_t q = num / den;
+  if ((num % den != 0) && (num < 0)) --q;
+  return q;
+}
+
+std::int64_t ceil_div(std::int64_t num, std::int64_t den) { return -floor_div(-num, den); }
+
+void require_axis(int full, int reduced, const char* what) {
+  if (full < 1 || reduced < 1 || reduced > full) {
+    throw std::invalid_argument(std::string(what) + ": need 1 <= reduced <= full, got full=" +
+                                std::to_string(full) + " reduced=" + std::to_string(reduced));
+  }
+}
+
+void require_sigma(double sigma) {
+  if (!(sigma > 0.0) || !std::isfinite(sigma)) {
+    throw std::invalid_argument("Gaussian sigma must be finite and > 0, got " + std::to_string(sigma));
+  }
+}
+
+// Taps of one output sample with indices already clamped into [0, full - 1] (replicate border).
+struct ClampedTaps {
+  std::vector<int> index;
+  std::vector<double> weight;
+};
+
+std::vector<ClampedTaps> clamped_gaussian_taps(int full, int reduced, double sigma) {
+  std::vector<ClampedTaps> all(static_cast<std::size_t>(reduced));
+  for (int x = 0; x < reduced; ++x) {
+    const GaussianTaps taps = gaussian_taps(x, full, reduced, sigma);
+    ClampedTaps& out = all[static_cast<std::size_t>(x)];
+    out.weight = taps.weights;
+    out.index.resize(taps.weights.size());
+    for (std::size_t k = 0; k < taps.weights.size(); ++k) {
+      out.index[k] = std::clamp(taps.first_index + static_cast<int>(k), 0, full - 1);
+    }
+  }
+  return all;
+}
+
+}  // namespace
+
+int reduced_size(int full, double r) {
+  if (full < 1) throw std::invalid_argument("reduced_size: full size must be >= 1, got " + std::to_string(full));
+  if (!(r > 0.0 && r <= 1.0)) {
+    throw std::invalid_argument("reduced_size: reduction r must be in (0, 1], got " + std::to_string(r));
+  }
+  // Round half up (97 x 0.5 -> 49), never below one pixel.
+  return std::max(1, static_cast<int>(std::floor(r * full + 0.5)));
+}
+
+double default_sigma(double r) {
+  if (!(r > 0.0 && r <= 1.0)) {
+    throw std::invalid_argument("default_sigma: reduction r must be in (0, 1], got " + std::to_string(r));
+  }
+  return 1.25 / r;  // sigma = 2.5 full pixels at r = 1/2 (paper Sec. 4.3)
+}
+
+double reduced_centre(int x_low, int full, int reduced) {
+  const std::int64_t num = (2 * static_cast<std::int64_t>(x_low) + 1) * full - reduced;
+  return static_cast<double>(num) / (2.0 * reduced);
+}
+
+int gaussian_radius(double sigma) {
+  require_sigma(sigma);
+  // R = ceil(3 sigma). sigma usually arrives as 1.25 / r, whose last-bit rounding can push 3 sigma just
+  // above an integer (e.g. 5.000000000000001); a relative slack of 1e-12 keeps such cases at the
+  // intended integer without affecting any sigma that is meaningfully above it.
+  return static_cast<int>(std::ceil(3.0 * sigma * (1.0 - 1e-12)));
+}
+
+GaussianTaps gaussian_taps(int x_low, int full, int reduced, double sigma) {
+  require_axis(full, reduced, "gaussian_taps");
+  const int radius = gaussian_radius(sigma);
+  // c = num / den exactly. |i - c| <= R  <=>  num - R den <= i den <= num + R den.
+  const std::int64_t den = 2 * static_cast<std::int64_t>(reduced);
+  const std::int64_t num = (2 * static_cast<std::int64_t>(x_low) + 1) * full - reduced;
+  const std::int64_t first = ceil_div(num - radius * den, den);
+  const std::int64_t last = floor_div(num + radius * den, den);
+
+  GaussianTaps taps;
+  taps.first_index = static_cast<int>(first);
+  taps.weights.reserve(static_cast<std::size_t>(last - first + 1));
+  const double inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+  double sum = 0.0;
+  for (std::int64_t i = first; i <= last; ++i) {
+    const double offset = static_cast<double>(i * den - num) / static_cast<double>(den);  // i - c
+    const double w = std::exp(-offset * offset * inv_two_sigma2);
+    taps.weights.push_back(w);
+    sum += w;
+  }
+  for (double& w : taps.weights) w /= sum;
+  return taps;
+}
+
+BilinearTap bilinear_tap(int x, int full, int reduced) {
+  require_axis(full, reduced, "bilinear_tap");
+  // x_low = num / den exactly, with num = (2x + 1) w - W and den = 2W.
+  const std::int64_t den = 2 * static_cast<std::int64_t>(full);
+  const std::int64_t num = (2 * static_cast<std::int64_t>(x) + 1) * reduced - full;
+  BilinearTap tap;
+  if (num < 0) {  // left of the first reduced centre: OpenCV INTER_LINEAR clamps to sample 0
+    tap.i0 = 0;
+    tap.i1 = std::min(1, reduced - 1);
+    tap.frac = 0.0;
+    return tap;
+  }
+  const std::int64_t i0 = num / den;
+  if (i0 >= reduced - 1) {  // at or right of the last reduced centre
+    tap.i0 = tap.i1 = reduced - 1;
+    tap.frac = 0.0;
+    return tap;
+  }
+  tap.i0 = static_cast<int>(i0);
+  tap.i1 = tap.i0 + 1;
+  tap.frac = static_cast<double>(num - i0 * den) / static_cast<double>(den);
+  return tap;
+}
+
+cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, double sigma) {
+  if (full.depth() != CV_64F || full.empty()) throw std::invalid_argument("downsample: expected a non-empty CV_64F matrix");
+  require_axis(full.cols, reduced_width, "downsample (width)");
+  require_axis(full.rows, reduced_height, "downsample (height)");
+  require_sigma(sigma);
+  const int channels = full.channels();
+  const std::vector<ClampedTaps> col_taps = clamped_gaussian_taps(full.cols, reduced_width, sigma);
+  const std::vector<ClampedTaps> row_taps = clamped_gaussian_taps(full.rows, reduced_height, sigma);
+
+  // Horizontal pass: every full row -> reduced_width samples.
+  cv::Mat horizontal(full.rows, reduced_width, full.type());
+  for (int y = 0; y < full.rows; ++y) {
+    const double* src = full.ptr<double>(y);
+    double* dst = horizontal.ptr<double>(y);
+    for (int x = 0; x < reduced_width; ++x) {
+      const ClampedTaps& taps = col_taps[static_cast<std::size_t>(x)];
+      for (int ch = 0; ch < channels; ++ch) {
+        double acc = 0.0;
+        for (std::size_t k = 0; k < taps.weight.size(); ++k) {
+          acc += taps.weight[k] * src[taps.index[k] * channels + ch];
+        }
+        dst[x * channels + ch] = acc;
+      }
+    }
+  }
+
+  // Vertical pass: whole-row multiply-accumulate keeps memory access sequential.
+  cv::Mat reduced(reduced_height, reduced_width, full.type());
+  const int row_len = reduced_width * channels;
+  for (int y = 0; y < reduced_height; ++y) {
+    const ClampedTaps& taps = row_taps[static_cast<std::size_t>(y)];
+    double* dst = reduced.ptr<double>(y);
+    std::fill(dst, dst + row_len, 0.0);
+    for (std::size_t k = 0; k < taps.weight.size(); ++k) {
+      const double w = taps.weight[k];
+      const double* src = horizontal.ptr<double>(taps.index[k]);
+      for (int i = 0; i < row_len; ++i) dst[i] += w * src[i];
+    }
+  }
+  return reduced;
+}
+
+cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height) {
+  if (reduced.depth() != CV_64F || reduced.empty()) throw std::invalid_argument("upsample: expected a non-empty CV_64F matrix");
+  require_axis(full_width, reduced.cols, "upsample (width)");
+  require_axis(full_height, reduced.rows, "upsample (height)");
+  const int channels = reduced.channels();
+
+  std::vector<BilinearTap> col_taps(static_cast<std::size_t>(full_width));
+  for (int x = 0; x < full_width; ++x) col_taps[static_cast<std::size_t>(x)] = bilinear_tap(x, full_width, reduced.cols);
+
+  // Horizontal pass on every reduced row (as OpenCV does), then a vertical blend of two such rows.
+  cv::Mat horizontal(reduced.rows, full_width, reduced.type());
+  for (int y = 0; y < reduced.rows; ++y) {
+    const double* src = reduced.ptr<double>(y);
+    double* dst = horizontal.ptr<double>(y);
+    for (int x = 0; x < full_width; ++x) {
+      const BilinearTap& t = col_taps[static_cast<std::size_t>(x)];
+      const double* a = src + t.i0 * channels;
+      const double* b = src + t.i1 * channels;
+      for (int ch = 0; ch < channels; ++ch) dst[x * channels + ch] = (1.0 - t.frac) * a[ch] + t.frac * b[ch];
+    }
+  }
+
+  cv::Mat full(full_height, full_width, reduced.type());
+  const int row_len = full_width * channels;
+  for (int y = 0; y < full_height; ++y) {
+    const BilinearTap t = bilinear_tap(y, full_height, reduced.rows);
+    const double* a = horizontal.ptr<double>(t.i0);
+    const double* b = horizontal.ptr<double>(t.i1);
+    double* dst = full.ptr<double>(y);
+    for (int i = 0; i < row_len; ++i) dst[i] = (1.0 - t.frac) * a[i] + t.frac * b[i];
+  }
+  return full;
+}
+
+}  // namespace trm

@@ -1,0 +1,126 @@
+// Transfer functions, link quantisation and luma (DESIGN §3).
+#include "trm/transfer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace trm {
+namespace {
+
+// IEC 61966-2-1 piecewise sRGB curve. The break points (0.04045 encoded, 0.0031308 linear) are the
+// standard's; the two branches meet to within 1e-7, which is far below a 16-bit code.
+constexpr double kSrgbEncodedBreak = 0.04045;
+constexpr double kSrgbLinearBreak = 0.0031308;
+constexpr double kSrgbSlope = 12.92;
+constexpr double kSrgbOffset = 0.055;
+constexpr double kSrgbExponent = 2.4;
+constexpr double kPureGamma = 2.2;
+
+double clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
+
+void require_double(const cv::Mat& m, const char* what) {
+  if (m.depth() != CV_64F) {
+    throw std::invalid_argument(std::string(what) + ": expected a CV_64F matrix");
+  }
+}
+
+// Applies f to every element of a CV_64F matrix of any channel count, returning a new matrix.
+template <typename F>
+cv::Mat map_elements(const cv::Mat& in, F f) {
+  cv::Mat out(in.size(), in.type());
+  const int row_len = in.cols * in.channels();
+  for (int y = 0; y < in.rows; ++y) {
+    const double* src = in.ptr<double>(y);
+    double* dst = out.ptr<double>(y);
+    for (int i = 0; i < row_len; ++i) dst[i] = f(src[i]);
+  }
+  return out;
+}
+
+void require_bits(int bits) {
+  if (bits < 1 || bits > 16) {
+    throw std::invalid_argument("quantisation bits must be in [1, 16], got " + std::to_string(bits));
+  }
+}
+
+}  // namespace
+
+double to_linear(double encoded, Transfer transfer) {
+  const double v = clamp01(encoded);
+  if (transfer == Transfer::Gamma22) return std::pow(v, kPureGamma);
+  if (v <= kSrgbEncodedBreak) return v / kSrgbSlope;
+  return std::pow((v + kSrgbOffset) / (1.0 + kSrgbOffset), kSrgbExponent);
+}
+
+double to_encoded(double linear, Transfer transfer) {
+  const double l = clamp01(linear);
+  if (transfer == Transfer::Gamma22) return std::pow(l, 1.0 / kPureGamma);
+  if (l <= kSrgbLinearBreak) return l * kSrgbSlope;
+  return (1.0 + kSrgbOffset) * std::pow(l, 1.0 / kSrgbExponent) - kSrgbOffset;
+}
+
+cv::Mat to_linear(const cv::Mat& encoded, Transfer transfer) {
+  require_double(encoded, "to_linear");
+  return map_elements(encoded, [transfer](double v) { return to_linear(v, transfer); });
+}
+
+cv::Mat to_encoded(const cv::Mat& linear, Transfer transfer) {
+  require_double(linear, "to_encoded");
+  return map_elements(linear, [transfer](double v) { return to_encoded(v, transfer); });
+}
+
+cv::Mat quantise(const cv::Mat& values, int bits) {
+  require_double(values, "quantise");
+  require_bits(bits);
+  const double max_code = static_cast<double>((1 << bits) - 1);
+  cv::Mat codes(values.size(), CV_MAKETYPE(CV_16U, values.channels()));
+  const int row_len = values.cols * values.channels();
+  for (int y = 0; y < values.rows; ++y) {
+    const double* src = values.ptr<double>(y);
+    std::uint16_t* dst = codes.ptr<std::uint16_t>(y);
+    for (int i = 0; i < row_len; ++i) {
+      // NaN would survive the clamp and make the integer conversion undefined: reject it here.
+      if (std::isnan(src[i])) throw std::invalid_argument("quantise: NaN value");
+      dst[i] = static_cast<std::uint16_t>(std::floor(clamp01(src[i]) * max_code + 0.5));
+    }
+  }
+  return codes;
+}
+
+cv::Mat dequantise(const cv::Mat& codes, int bits) {
+  if (codes.depth() != CV_16U) throw std::invalid_argument("dequantise: expected a CV_16U matrix");
+  require_bits(bits);
+  const double max_code = static_cast<double>((1 << bits) - 1);
+  cv::Mat values(codes.size(), CV_MAKETYPE(CV_64F, codes.channels()));
+  const int row_len = codes.cols * codes.channels();
+  for (int y = 0; y < codes.rows; ++y) {
+    const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
+    double* dst = values.ptr<double>(y);
+    for (int i = 0; i < row_len; ++i) {
+      // Codes above the maximum cannot come from quantise(); they indicate a bit-depth mix-up.
+      if (src[i] > max_code) {
+        throw std::invalid_argument("dequantise: code " + std::to_string(src[i]) + " exceeds " +
+                                    std::to_string(bits) + "-bit range");
+      }
+      dst[i] = src[i] / max_code;
+    }
+  }
+  return values;
+}
+
+cv::Mat luma(const cv::Mat& linear_rgb) {
+  if (linear_rgb.type() != CV_64FC3) throw std::invalid_argument("luma: expected CV_64FC3 (RGB)");
+  cv::Mat y(linear_rgb.size(), CV_64FC1);
+  for (int r = 0; r < linear_rgb.rows; ++r) {
+    const double* src = linear_rgb.ptr<double>(r);
+    double* dst = y.ptr<double>(r);
+    for (int x = 0; x < linear_rgb.cols; ++x) {
+      dst[x] = 0.2126 * src[3 * x] + 0.7152 * src[3 * x + 1] + 0.0722 * src[3 * x + 2];
+    }
+  }
+  return y;
+}
+
+}  // namespace trm

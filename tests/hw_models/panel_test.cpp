@@ -1,0 +1,267 @@
+// Panel models: preset parsing, OLED gamma round trip, the LCD merge (Eq. 7) and its stable inverse.
+#include "trm/panel.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace trm {
+namespace {
+
+// Independent oracle for a merge that increases in v_t on [0, 1]: plain bisection on M(v, v_prev) = m.
+double bisect_monotone(const LcdPanel& lcd, double m, double v_prev) {
+  double lo = 0.0;
+  double hi = 1.0;
+  for (int i = 0; i < 200 && hi - lo > 0.0; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid == lo || mid == hi) break;
+    (lcd.merge(mid, v_prev) < m ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+LcdPanel lcd_with(double p1, double p2, double p3, double p4) {
+  LcdPanel lcd;
+  lcd.p1 = p1;
+  lcd.p2 = p2;
+  lcd.p3 = p3;
+  lcd.p4 = p4;
+  return lcd;
+}
+
+TEST(ParsePanel, OledPresetsCarryTheMeasuredGammas) {
+  const Panel vive = parse_panel("vive");
+  EXPECT_EQ(vive.kind, PanelKind::Oled);
+  EXPECT_EQ(vive.oled.gamma, (std::array<double, 3>{2.2912, 2.2520, 2.1940}));
+  EXPECT_DOUBLE_EQ(vive.oled.duty, 0.2);
+
+  const Panel rift = parse_panel("rift");
+  EXPECT_EQ(rift.kind, PanelKind::Oled);
+  EXPECT_EQ(rift.oled.gamma, (std::array<double, 3>{2.1526, 2.0910, 2.0590}));
+  EXPECT_DOUBLE_EQ(rift.oled.duty, 0.2);
+
+  EXPECT_EQ(parse_panel("generic").oled.gamma, (std::array<double, 3>{2.2, 2.2, 2.2}));
+  EXPECT_EQ(parse_panel("gamma:2.4").oled.gamma, (std::array<double, 3>{2.4, 2.4, 2.4}));
+  EXPECT_EQ(parse_panel("gamma:2.1,2.2,2.3").oled.gamma, (std::array<double, 3>{2.1, 2.2, 2.3}));
+  EXPECT_EQ(parse_panel("gamma:2.4").name, "gamma:2.4");
+}
+
+TEST(ParsePanel, LcdDefaultsAndCustomParameters) {
+  const Panel lcd = parse_panel("lcd");
+  EXPECT_EQ(lcd.kind, PanelKind::Lcd);
+  EXPECT_DOUBLE_EQ(lcd.lcd.p1, -0.1);
+  EXPECT_DOUBLE_EQ(lcd.lcd.p2, 0.2);
+  EXPECT_DOUBLE_EQ(lcd.lcd.p3, 0.5);
+  EXPECT_DOUBLE_EQ(lcd.lcd.p4, 0.0);
+  EXPECT_DOUBLE_EQ(lcd.lcd.gamma, 2.2);
+
+  const Panel custom = parse_panel("lcd:-0.05,0.1,0.5,0.01,2.4");
+  EXPECT_EQ(custom.kind, PanelKind::Lcd);
+  EXPECT_DOUBLE_EQ(custom.lcd.p1, -0.05);
+  EXPECT_DOUBLE_EQ(custom.lcd.p2, 0.1);
+  EXPECT_DOUBLE_EQ(custom.lcd.p3, 0.5);
+  EXPECT_DOUBLE_EQ(custom.lcd.p4, 0.01);
+  EXPECT_DOUBLE_EQ(custom.lcd.gamma, 2.4);
+}
+
+TEST(ParsePanel, RejectsBadSpecsNamingTheAcceptedForms) {
+  for (const char* bad : {"", "oled", "VIVE", "gamma:", "gamma:0", "gamma:-2.2", "gamma:2.2,2.2",
+                          "gamma:2.2,,2.2", "gamma:2.2x", "gamma:nan", "gamma:inf", "lcd:", "lcd:1,2,3",
+                          "lcd:nan,0.2,0.5,0,2.2", "lcd:-0.1,0.2,0.5,0,0", "lcd:-0.1,0.2,0.5,0,-2.2",
+                          "lcd:-0.1,0.2,0.5,0,2.2,1", "lcd:-0.1,0.2,0.5,inf,2.2"}) {
+    SCOPED_TRACE(bad);
+    try {
+      parse_panel(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const std::invalid_argument& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("accepted panel specs"), std::string::npos) << message;
+      EXPECT_NE(message.find("lcd:p1,p2,p3,p4,gamma"), std::string::npos) << message;
+    }
+  }
+}
+
+TEST(ParsePanel, RejectionSaysWhatIsWrong) {
+  const auto message_of = [](const char* spec) {
+    try {
+      parse_panel(spec);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message_of("lcd:nan,0.2,0.5,0,2.2").find("finite"), std::string::npos);
+  EXPECT_NE(message_of("lcd:-0.1,0.2,0.5,0,0").find("gamma must be > 0"), std::string::npos);
+  EXPECT_NE(message_of("gamma:0").find("> 0"), std::string::npos);
+}
+
+TEST(OledPanel, DriveIsTheInverseGammaPerChannel) {
+  const Panel vive = parse_panel("vive");
+  for (int channel = 0; channel < 3; ++channel) {
+    const double gamma = vive.oled.gamma[static_cast<std::size_t>(channel)];
+    for (int k = 0; k <= 100; ++k) {
+      const double x = k / 100.0;
+      const double v = vive.drive_from_linear(x, channel);
+      EXPECT_NEAR(v, std::pow(x, 1.0 / gamma), 1e-15);
+      EXPECT_NEAR(vive.linear_from_drive(v, channel), x, 1e-14);
+    }
+  }
+  // The channels differ: a grey input gets a slightly different drive per primary.
+  EXPECT_LT(vive.drive_from_linear(0.5, 0), vive.drive_from_linear(0.5, 2));
+  // Out-of-range linear input is clamped to the displayable range.
+  EXPECT_EQ(vive.drive_from_linear(1.5, 1), 1.0);
+  EXPECT_EQ(vive.drive_from_linear(-0.5, 1), 0.0);
+}
+
+TEST(LcdPanel, MergeMatchesEquation7) {
+  const LcdPanel lcd = lcd_with(0.3, -0.2, 0.7, 0.05);
+  const double vt = 0.6;
+  const double vp = 0.25;
+  EXPECT_DOUBLE_EQ(lcd.merge(vt, vp), 0.3 * (0.36 + 0.0625) - 0.2 * 0.15 + 0.7 * 0.85 + 0.05);
+}
+
+TEST(LcdPanel, DefaultsMergeAHeldValueToItself) {
+  const LcdPanel lcd;
+  for (int k = 0; k <= 256; ++k) {
+    const double v = k / 256.0;
+    EXPECT_NEAR(lcd.merge(v, v), v, 1e-15);
+  }
+  // The default merge is M = p1 (vt - vp)^2 + (vt + vp) / 2: the transitions lose a little.
+  EXPECT_NEAR(lcd.merge(1.0, 0.0), 0.4, 1e-15);
+  EXPECT_NEAR(lcd.merge(0.0, 1.0), 0.4, 1e-15);
+}
+
+TEST(LcdPanel, InverseRoundTripsWhereReachableAndAgreesWithBisection) {
+  const LcdPanel lcd;
+  int reachable_count = 0;
+  for (int j = 0; j <= 64; ++j) {
+    const double vp = j / 64.0;
+    // The default merge increases in v_t, so the reachable range is [M(0, vp), M(1, vp)].
+    const double lowest = lcd.merge(0.0, vp);
+    const double highest = lcd.merge(1.0, vp);
+    for (int k = 0; k <= 200; ++k) {
+      const double m = -0.1 + 1.2 * k / 200.0;
+      SCOPED_TRACE(testing::Message() << "m=" << m << " vp=" << vp);
+      const LcdPanel::Solution s = lcd.solve(m, vp);
+      ASSERT_GE(s.v, 0.0);
+      ASSERT_LE(s.v, 1.0);
+      if (m >= lowest && m <= highest) {
+        ++reachable_count;
+        EXPECT_TRUE(s.reachable);
+        EXPECT_NEAR(lcd.merge(s.v, vp), m, 1e-12);
+        EXPECT_NEAR(s.v, bisect_monotone(lcd, m, vp), 1e-12);
+      } else {
+        EXPECT_FALSE(s.reachable);
+        EXPECT_EQ(s.v, m < lowest ? 0.0 : 1.0);
+      }
+    }
+  }
+  EXPECT_GT(reachable_count, 5000);  // the grid exercises the reachable region well
+}
+
+TEST(LcdPanel, ExactlyLinearMergeUsesTheLinearSolve) {
+  // p1 = 0: M = p2 vt vp + p3 (vt + vp) + p4, linear in vt.
+  const LcdPanel lcd = lcd_with(0.0, 0.1, 0.45, 0.02);
+  for (double vp : {0.0, 0.3, 1.0}) {
+    for (double m : {0.05, 0.2, 0.4}) {
+      const double linear_root = (m - 0.45 * vp - 0.02) / (0.1 * vp + 0.45);
+      const LcdPanel::Solution s = lcd.solve(m, vp);
+      EXPECT_TRUE(s.reachable);
+      EXPECT_DOUBLE_EQ(s.v, linear_root);
+    }
+  }
+}
+
+TEST(LcdPanel, NearlyLinearMergeHasNoCatastrophicCancellation) {
+  // With tiny p1 the textbook (-b + sqrt(b^2 - 4ac)) / 2a loses about |log10(p1)| digits; the stable form
+  // must stay on the root next to the linear one and hit m to rounding.
+  for (double p1 : {1e-12, -1e-9, 1e-15, -1e-14}) {
+    const LcdPanel lcd = lcd_with(p1, -2.0 * p1, 0.5, 0.0);
+    for (double vp : {0.0, 0.2, 0.7, 1.0}) {
+      for (double m : {0.01, 0.25, 0.5, 0.9}) {
+        SCOPED_TRACE(testing::Message() << "p1=" << p1 << " vp=" << vp << " m=" << m);
+        const double linear_root = (m - 0.5 * vp) / 0.5;  // the p1 = 0 solution
+        const LcdPanel::Solution s = lcd.solve(m, vp);
+        if (linear_root < 0.0 || linear_root > 1.0) {
+          EXPECT_FALSE(s.reachable);
+          continue;
+        }
+        EXPECT_TRUE(s.reachable);
+        EXPECT_NEAR(s.v, linear_root, 4.0 * std::abs(p1));  // the root moves by O(p1) only
+        EXPECT_NEAR(lcd.merge(s.v, vp), m, 1e-15);
+        EXPECT_NEAR(s.v, bisect_monotone(lcd, m, vp), 1e-15);
+      }
+    }
+  }
+}
+
+TEST(LcdPanel, TwoRootsInRangePicksTheBranchContinuousWithTheLinearSolve) {
+  // M(v, 0) = -v^2 + v: m = 0.16 has roots 0.2 and 0.8. As p1 -> 0 the solution tends to m / p3 = 0.16,
+  // which the 0.2 root continues; 0.8 runs off to infinity.
+  const LcdPanel lcd = lcd_with(-1.0, 0.0, 1.0, 0.0);
+  const LcdPanel::Solution s = lcd.solve(0.16, 0.0);
+  EXPECT_TRUE(s.reachable);
+  EXPECT_NEAR(s.v, 0.2, 1e-15);
+}
+
+TEST(LcdPanel, NoRealRootClampsToTheVertex) {
+  // M(v, 0) = v^2 - v has its minimum -0.25 at v = 0.5; m = -0.5 has no real root.
+  const LcdPanel lcd = lcd_with(1.0, 0.0, -1.0, 0.0);
+  const LcdPanel::Solution s = lcd.solve(-0.5, 0.0);
+  EXPECT_FALSE(s.reachable);
+  EXPECT_DOUBLE_EQ(s.v, 0.5);
+  // Tangent: m = -0.25 touches the vertex, reachable.
+  const LcdPanel::Solution tangent = lcd.solve(-0.25, 0.0);
+  EXPECT_TRUE(tangent.reachable);
+  EXPECT_NEAR(tangent.v, 0.5, 1e-7);
+}
+
+TEST(LcdPanel, RootsOutsideTheRangeClampToTheClosestEnd) {
+  // M(v, 0) = v^2: m = 4 has roots +-2, both outside [0, 1]; M(1) = 1 is the closest.
+  const LcdPanel squares = lcd_with(1.0, 0.0, 0.0, 0.0);
+  const LcdPanel::Solution high = squares.solve(4.0, 0.0);
+  EXPECT_FALSE(high.reachable);
+  EXPECT_EQ(high.v, 1.0);
+
+  // Defaults from black: the brightest merged value is M(1, 0) = 0.4.
+  const LcdPanel lcd;
+  const LcdPanel::Solution from_black = lcd.solve(0.9, 0.0);
+  EXPECT_FALSE(from_black.reachable);
+  EXPECT_EQ(from_black.v, 1.0);
+  // From white the darkest merged value is M(0, 1) = 0.4.
+  const LcdPanel::Solution from_white = lcd.solve(0.0, 1.0);
+  EXPECT_FALSE(from_white.reachable);
+  EXPECT_EQ(from_white.v, 0.0);
+  // Exactly at the edge is reachable.
+  const LcdPanel::Solution edge = lcd.solve(lcd.merge(1.0, 0.0), 0.0);
+  EXPECT_TRUE(edge.reachable);
+  EXPECT_NEAR(edge.v, 1.0, 1e-12);
+}
+
+TEST(LcdPanel, HeldDriveRoundTripsEvenWhenTheMergeIsNotTheIdentity) {
+  // M(v, v) = -0.1 v^2 + v here, so the held drive is not simply x^(1/gamma).
+  const Panel panel = parse_panel("lcd:-0.1,0.1,0.5,0,2.2");
+  for (int k = 0; k <= 100; ++k) {
+    const double x = std::pow(k / 100.0, 2.0) * std::pow(0.9, 2.2);  // M(1, 1)^gamma = 0.9^2.2 is the top
+    const double v = panel.drive_from_linear(x, 0);
+    EXPECT_NEAR(panel.linear_from_drive(v, 0), x, 1e-13);
+  }
+  // Defaults: the held drive is x^(1/gamma).
+  const Panel lcd = parse_panel("lcd");
+  EXPECT_NEAR(lcd.drive_from_linear(0.3, 1), std::pow(0.3, 1.0 / 2.2), 1e-15);
+}
+
+TEST(PerceivedPair, IsTheTimeAverage) {
+  cv::Mat a(2, 3, CV_64FC3, cv::Scalar(0.2, 0.4, 1.0));
+  cv::Mat b(2, 3, CV_64FC3, cv::Scalar(0.6, 0.0, 1.0));
+  const cv::Mat p = perceived_pair(a, b);
+  ASSERT_EQ(p.type(), CV_64FC3);
+  EXPECT_EQ(p.at<cv::Vec3d>(1, 2), cv::Vec3d(0.4, 0.2, 1.0));
+  EXPECT_THROW(perceived_pair(a, cv::Mat(2, 2, CV_64FC3)), std::invalid_argument);
+  EXPECT_THROW(perceived_pair(a, cv::Mat(2, 3, CV_32FC3)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace trm

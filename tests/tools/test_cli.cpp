@@ -1,0 +1,203 @@
+// End-to-end checks of the `trm` command line: exit codes, messages, outputs written whole or not at all.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Result run_trm(const std::string& args) {
+  const std::string command = std::string(TRM_EXECUTABLE) + " " + args + " 2>&1";
+  Result result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer{};
+  while (fgets(buffer.data(), static_cast<int>(buffer.size()), pipe)) result.output += buffer.data();
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() / ("trm-cli-" + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  const fs::path& path() const { return path_; }
+  std::string str(const std::string& child) const { return (path_ / child).string(); }
+
+ private:
+  fs::path path_;
+};
+
+// Writes n random 8-bit sRGB frames (RGB noise, deterministic) as frame_000.png ...
+void write_frames(const fs::path& dir, int n, int width, int height, bool same = false) {
+  fs::create_directories(dir);
+  cv::RNG rng(1234);
+  cv::Mat frame(height, width, CV_8UC3);
+  for (int i = 0; i < n; ++i) {
+    if (i == 0 || !same) rng.fill(frame, cv::RNG::UNIFORM, 0, 256);
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%03d.png", i);
+    ASSERT_TRUE(cv::imwrite((dir / name).string(), frame));
+  }
+}
+
+bool no_partial_left(const fs::path& parent) {
+  for (const auto& entry : fs::directory_iterator(parent)) {
+    if (entry.path().filename().string().find(".partial-") != std::string::npos) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+  const Result version = run_trm("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.output.find("trm "), std::string::npos);
+  const Result help = run_trm("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("run"), std::string::npos);
+  EXPECT_NE(help.output.find("decode"), std::string::npos);
+}
+
+TEST(Cli, UnknownSubcommandOrOptionFails) {
+  EXPECT_NE(run_trm("frobnicate").exit_code, 0);
+  EXPECT_NE(run_trm("run --no-such-option").exit_code, 0);
+}
+
+TEST(Cli, DecodeWritesDriveFramesAtBothDepths) {
+  TempDir tmp;
+  write_frames(tmp.path() / "in", 4, 17, 11);
+  const Result r8 = run_trm("decode --input '" + tmp.str("in/frame_*.png") + "' --out " + tmp.str("out8"));
+  ASSERT_EQ(r8.exit_code, 0) << r8.output;
+  for (int t = 0; t < 4; ++t) {
+    char name[32];
+    std::snprintf(name, sizeof name, "drive8_%04d.png", t);
+    const cv::Mat codes = cv::imread(tmp.str("out8/") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(codes.empty()) << name;
+    EXPECT_EQ(codes.depth(), CV_8U);
+    EXPECT_EQ(codes.cols, 17);
+    EXPECT_EQ(codes.rows, 11);
+    std::snprintf(name, sizeof name, "drive_%04d.png", t);
+    const cv::Mat drive = cv::imread(tmp.str("out8/") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(drive.empty()) << name;
+    EXPECT_EQ(drive.depth(), CV_16U);
+    // The 8-bit codes are the 16-bit drive quantised: they agree to within one 8-bit step.
+    cv::Mat drive_as_8;
+    drive.convertTo(drive_as_8, CV_64F, 255.0 / 65535.0);
+    cv::Mat codes_d;
+    codes.convertTo(codes_d, CV_64F);
+    EXPECT_LE(cv::norm(drive_as_8, codes_d, cv::NORM_INF), 0.5 + 255.0 / 65535.0);
+  }
+  EXPECT_TRUE(fs::exists(tmp.path() / "out8" / "report.json"));
+
+  const Result r10 =
+      run_trm("decode --input '" + tmp.str("in/frame_*.png") + "' --out " + tmp.str("out10") + " --bits 10");
+  ASSERT_EQ(r10.exit_code, 0) << r10.output;
+  const cv::Mat codes10 = cv::imread(tmp.str("out10/drive10_0001.png"), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(codes10.empty());
+  EXPECT_EQ(codes10.depth(), CV_16U);
+  double max_code = 0;
+  cv::minMaxLoc(codes10.reshape(1), nullptr, &max_code);
+  EXPECT_LE(max_code, 1023.0);
+}
+
+TEST(Cli, DecodeBadInputsFailCleanlyWithoutPartialOutput) {
+  TempDir tmp;
+  write_frames(tmp.path() / "in", 2, 8, 6);
+  const std::string input = " --input '" + tmp.str("in/frame_*.png") + "'";
+  struct Case {
+    std::string args;
+    std::string message;  // a fragment the error must contain
+  };
+  fs::create_directories(tmp.path() / "mixed");
+  write_frames(tmp.path() / "mixed", 1, 8, 6);
+  ASSERT_TRUE(cv::imwrite(tmp.str("mixed/frame_001.png"), cv::Mat(7, 8, CV_8UC3, cv::Scalar::all(3))));
+  fs::create_directories(tmp.path() / "notimage");
+  { std::ofstream(tmp.path() / "notimage" / "frame_000.png") << "this is not a PNG"; }
+
+  const std::vector<Case> cases = {
+      {"decode --input '" + tmp.str("nothing/frame_*.png") + "' --out " + tmp.str("o1"), "frame_*"},
+      {"decode --input '" + tmp.str("mixed/frame_*.png") + "' --out " + tmp.str("o2"), "frame_001"},
+      {"decode --input '" + tmp.str("notimage/frame_*.png") + "' --out " + tmp.str("o3"), "frame_000"},
+      {"decode" + input + " --out " + tmp.str("o4") + " --reduction 0", "reduction"},
+      {"decode" + input + " --out " + tmp.str("o5") + " --reduction 1.5", "reduction"},
+      {"decode" + input + " --out " + tmp.str("o6") + " --sigma -1", "sigma"},
+      {"decode" + input + " --out " + tmp.str("o7") + " --panel plasma", "plasma"},
+      {"decode" + input + " --out " + tmp.str("o8") + " --bits 12", "bits"},
+      {"decode" + input + " --out " + tmp.str("o9") + " --impl magic", "magic"},
+      {"run --scene nosuchscene --out " + tmp.str("o10"), "nosuchscene"},
+      {"run --frames 2 --size 0x4 --out " + tmp.str("o11"), "size"},
+  };
+  for (const Case& c : cases) {
+    const Result r = run_trm(c.args);
+    EXPECT_NE(r.exit_code, 0) << c.args;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.find("terminate called"), std::string::npos) << r.output;
+  }
+  for (const char* out : {"o1", "o2", "o3", "o4", "o5", "o6", "o7", "o8", "o9", "o10", "o11"}) {
+    EXPECT_FALSE(fs::exists(tmp.path() / out)) << out;
+  }
+  EXPECT_TRUE(no_partial_left(tmp.path()));
+}
+
+TEST(Cli, RunRefusesToReplaceAForeignDirectory) {
+  TempDir tmp;
+  fs::create_directories(tmp.path() / "precious");
+  { std::ofstream(tmp.path() / "precious" / "thesis.tex") << "do not delete"; }
+  const Result r = run_trm("run --frames 2 --size 16x12 --out " + tmp.str("precious"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(fs::exists(tmp.path() / "precious" / "thesis.tex"));
+  EXPECT_TRUE(no_partial_left(tmp.path()));
+}
+
+TEST(Cli, RunWritesReportAndPreviews) {
+  TempDir tmp;
+  const Result r = run_trm("run --scene discs --frames 4 --size 48x40 --out " + tmp.str("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(tmp.path() / "out" / "report.json");
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["frames"].size(), 4u);
+  EXPECT_EQ(report["parameters"]["size"][0], 48);
+  EXPECT_EQ(report["parameters"]["reduced_size"][0], 24);
+  // Pixel ratio over whole pairs: (W H + w h) / (2 W H) = (48*40 + 24*20) / (2*48*40) = 0.625.
+  EXPECT_DOUBLE_EQ(report["summary"]["pixel_ratio"].get<double>(), 0.625);
+  for (const char* name : {"pair_sent_full.png", "pair_sent_reduced.png", "pair_shown_beta.png",
+                           "pair_shown_alpha.png", "pair_perceived.png", "pair_full_rate_reference.png"}) {
+    EXPECT_TRUE(fs::exists(tmp.path() / "out" / name)) << name;
+  }
+  const cv::Mat reduced = cv::imread(tmp.str("out/pair_sent_reduced.png"));
+  EXPECT_EQ(reduced.cols, 24);
+  EXPECT_EQ(reduced.rows, 20);
+  // Running again over our own output replaces it.
+  EXPECT_EQ(run_trm("run --scene discs --frames 2 --size 48x40 --out " + tmp.str("out")).exit_code, 0);
+}
+
+TEST(Cli, LowRefreshWarnsButRuns) {
+  TempDir tmp;
+  const Result r = run_trm("run --frames 2 --size 16x12 --refresh 60 --out " + tmp.str("out"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("flicker"), std::string::npos);
+}

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Installs the Debian packages trm needs (only those missing) and configures + builds.
+# Usage: tools/setup.sh [BUILD_DIR] [extra cmake args...]
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="${1:-$here/build}"
+shift || true
+
+packages=(
+  build-essential cmake pkg-config
+  libopencv-dev            # image/video I/O, reference filters (GaussianBlur, resize), DFT
+  libusb-1.0-0-dev         # USB bulk rig feeder
+  libhidapi-dev            # HID rig feeder (hidraw + libusb backends)
+  libgtest-dev libgmock-dev
+  libbenchmark-dev         # Google Benchmark
+  libsystemc-dev           # sc_fixed: independent oracle for the fixed-point type
+  libcli11-dev             # command-line parsing
+  nlohmann-json3-dev       # report.json
+  zlib1g-dev               # CRC32 for link packets
+  libcharls-dev            # JPEG-LS lossless link codec
+  umockdev libumockdev-dev # emulated USB/HID devices for rig tests
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  [[ "$p" == \#* ]] && continue
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]})); then
+  echo "trm setup: installing missing Debian packages: ${missing[*]}" >&2
+  sudo_cmd=()
+  if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+jobs="$(nproc 2>/dev/null || echo 2)"
+if [[ ! -f "$build_dir/CMakeCache.txt" ]]; then
+  cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "$@"
+fi
+cmake --build "$build_dir" -j "$jobs"

@@ -1,0 +1,39 @@
+#include "commands.hpp"
+
+#include <exception>
+#include <iostream>
+
+#ifndef TRM_VERSION
+#define TRM_VERSION "0.0.0"
+#endif
+
+namespace trm::cli {
+
+int run_main(int argc, char** argv) {
+  CLI::App app{"trm: headset-side Temporal Resolution Multiplexing simulator "
+               "(GPU-side encoder, simulated link, bit-accurate display-controller decoder, panel and eye models)"};
+  app.set_version_flag("--version", std::string("trm ") + TRM_VERSION);
+  app.require_subcommand(0, 1);
+
+  Action action;
+  register_run(app, action);
+  register_decode(app, action);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  if (!action) {
+    std::cout << app.help();
+    return 0;
+  }
+  try {
+    return action();
+  } catch (const std::exception& e) {
+    std::cerr << "trm: error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace trm::cli

@@ -1,0 +1,81 @@
+// `trm decode`: the contract hardware users and independent checks rely on. Input PNGs are the GPU's
+// full-resolution renders (sRGB-encoded); the encoder and decoder run on them and the panel drive of every
+// frame is written as drive_NNNN.png (16 bit: round(v * 65535) of the unquantised drive) and
+// driveB_NNNN.png (the B-bit drive codes; 10-bit codes are stored in a 16-bit PNG).
+#include "commands.hpp"
+#include "output_dir.hpp"
+#include "pipeline.hpp"
+#include "run_report.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace trm::cli {
+
+namespace {
+
+std::string numbered(const std::string& prefix, std::int64_t index) {
+  char name[64];
+  std::snprintf(name, sizeof name, "%s_%04lld.png", prefix.c_str(), static_cast<long long>(index));
+  return name;
+}
+
+cv::Mat drive_16bit(const cv::Mat& drive) {
+  cv::Mat out(drive.size(), CV_16UC3);
+  for (int y = 0; y < drive.rows; ++y) {
+    const auto* src = drive.ptr<cv::Vec3d>(y);
+    auto* dst = out.ptr<cv::Vec3w>(y);
+    for (int x = 0; x < drive.cols; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        // round half up of v * 65535, v already in [0, 1]
+        dst[x][c] = static_cast<std::uint16_t>(std::floor(std::clamp(src[x][c], 0.0, 1.0) * 65535.0 + 0.5));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void register_decode(CLI::App& app, Action& action) {
+  auto options = std::make_shared<PipelineOptions>();
+  auto out = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "decode", "Encode and decode an input sequence, writing the panel drive of every frame (drive_*.png, drive8_*.png "
+                "or drive10_*.png) and report.json");
+  options->add_options(*cmd);
+  cmd->get_option("--input")->required();
+  cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->required();
+  cmd->callback([options, out, &action] {
+    action = [options, out] {
+      options->validate();
+      if (options->refresh_hz < 90.0) {
+        std::cerr << "trm: warning: refresh " << options->refresh_hz << " Hz is below 90 Hz: expect visible flicker\n";
+      }
+      const auto start = std::chrono::steady_clock::now();
+      OutputDir dir(*out);
+      RunRecorder recorder(*options);
+      const std::string code_prefix = "drive" + std::to_string(options->output_bits);
+      const std::int64_t frames = run_pipeline(*options, [&](const DecodedView& view) {
+        recorder.add(view);
+        const std::int64_t t = view.sent->meta.index;
+        const std::string eye = view.sent->meta.eye == 0 ? "" : "_right";
+        dir.write_png(numbered("drive" + eye, t), drive_16bit(view.decoded->drive));
+        cv::Mat codes = view.decoded->drive_codes;
+        if (options->output_bits == 8) codes.convertTo(codes, CV_8U);  // 8-bit codes as an 8-bit PNG
+        dir.write_png(numbered(code_prefix + eye, t), codes);
+      });
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      dir.write_text("report.json", recorder.report(wall).dump(2) + "\n");
+      dir.commit();
+      std::cout << "trm decode: " << frames << " frames -> " << dir.target().string() << "/\n"
+                << recorder.summary_table();
+      return 0;
+    };
+  });
+}
+
+}  // namespace trm::cli

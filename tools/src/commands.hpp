@@ -1,0 +1,11 @@
+// Register functions of the subcommands (one per tools/src/cmd_<name>.cpp).
+#pragma once
+
+#include "trm/cli.hpp"
+
+namespace trm::cli {
+
+void register_run(CLI::App& app, Action& action);
+void register_decode(CLI::App& app, Action& action);
+
+}  // namespace trm::cli

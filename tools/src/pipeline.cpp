@@ -1,0 +1,158 @@
+#include "pipeline.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+namespace trm::cli {
+
+namespace {
+
+bool looks_like_image_sequence(const std::string& input) {
+  const std::string ext = std::filesystem::path(input).extension().string();
+  if (input.find_first_of("*?") != std::string::npos) return true;
+  for (const char* e : {".png", ".PNG", ".tif", ".tiff", ".jpg", ".jpeg", ".exr", ".bmp"}) {
+    if (ext == e) return true;
+  }
+  return false;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void PipelineOptions::add_options(CLI::App& cmd) {
+  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter)")
+      ->capture_default_str();
+  cmd.add_option("--input", input, "Image sequence glob ('DIR/frame_*.png', sorted by name, sRGB) or a video file");
+  cmd.add_option("--image", image, "Image for the panorama and static scenes (default: procedural texture)");
+  cmd.add_option("--frames", frames, "Number of frames (default: all input frames, or " +
+                                         std::to_string(default_frames) + " for a scene)");
+  cmd.add_option_function<std::string>(
+         "--size",
+         [this](const std::string& s) {
+           int w = 0, h = 0;
+           char x = 0, extra = 0;
+           if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 ||
+               h < 1) {
+             throw CLI::ValidationError("--size", "expected WxH with W, H >= 1, got '" + s + "'");
+           }
+           width = w;
+           height = h;
+         },
+         "View size WxH for built-in scenes (default 1080x1200, one eye of a Vive-class headset)");
+  cmd.add_option("--refresh", refresh_hz, "Panel refresh rate in Hz")->capture_default_str();
+  cmd.add_option("--reduction,-r", encoder.reduction, "Resolution reduction r in (0, 1]")->capture_default_str();
+  cmd.add_option("--sigma", encoder.sigma, "Gaussian sigma of D in full-resolution pixels (default 1.25 / r)");
+  cmd.add_option("--phase", encoder.phase, "0: even frames full, odd reduced; 1: swapped")->capture_default_str();
+  cmd.add_option_function<std::string>(
+      "--transfer", [this](const std::string& s) { encoder.transfer = parse_transfer(s); },
+      "Link transfer function: srgb (default) or gamma2.2");
+  cmd.add_option_function<std::string>(
+      "--resample-space", [this](const std::string& s) { encoder.resample_space = parse_resample_space(s); },
+      "Space in which D and U act: encoded (default) or linear");
+  cmd.add_option_function<int>(
+      "--bits",
+      [this](int b) {
+        encoder.bits = b;
+        output_bits = b;
+      },
+      "Bits per channel on the link and of the panel drive codes: 8 (default) or 10");
+  cmd.add_option("--link-bits", encoder.bits, "Link bits only (overrides --bits)");
+  cmd.add_option("--output-bits", output_bits, "Drive code bits only (overrides --bits)");
+  cmd.add_flag("--stereo", encoder.stereo, "Two eyes off-phase: every link frame carries one full and one reduced view");
+  cmd.add_option("--sensitivity,-s", sensitivity, "Motion sensitivity s in w = exp(-s c)")->capture_default_str();
+  cmd.add_option("--panel", panel, "vive | rift | generic | gamma:G | gamma:GR,GG,GB | lcd | lcd:p1,p2,p3,p4,gamma")
+      ->capture_default_str();
+  cmd.add_option("--seed", seed, "Seed for scenes with randomness")->capture_default_str();
+  cmd.add_option("--impl", impl, "Decoder implementation: reference")->capture_default_str();
+}
+
+void PipelineOptions::validate() const {
+  encoder.validate();
+  if (!(std::isfinite(sensitivity) && sensitivity >= 0.0)) {
+    throw std::invalid_argument("--sensitivity must be a finite number >= 0");
+  }
+  if (!(std::isfinite(refresh_hz) && refresh_hz > 0.0)) {
+    throw std::invalid_argument("--refresh must be a positive number of Hz");
+  }
+  if (frames < 0) throw std::invalid_argument("--frames must be >= 0");
+  if (output_bits != 8 && output_bits != 10) throw std::invalid_argument("output bits must be 8 or 10");
+  if (impl != "reference") {
+    throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference)");
+  }
+  (void)parse_panel(panel);
+  if (input.empty()) {
+    bool known = false;
+    for (const auto& name : scene_names()) known = known || name == scene;
+    if (!known) {
+      std::string list;
+      for (const auto& name : scene_names()) list += (list.empty() ? "" : ", ") + name;
+      throw std::invalid_argument("unknown scene '" + scene + "' (available: " + list + ")");
+    }
+  }
+}
+
+std::int64_t run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink) {
+  options.validate();
+  std::unique_ptr<FrameSource> source;
+  if (!options.input.empty()) {
+    source = looks_like_image_sequence(options.input) ? open_image_sequence(options.input) : open_video(options.input);
+  } else {
+    SceneParams params;
+    params.width = options.width;
+    params.height = options.height;
+    params.refresh_hz = options.refresh_hz;
+    params.seed = options.seed;
+    params.image_path = options.image;
+    source = make_scene(options.scene, params);
+  }
+
+  std::int64_t frames = options.frames;
+  const auto available = source->frame_count();
+  if (available) {
+    if (*available == 0) throw std::runtime_error("input '" + options.input + "' has no frames");
+    if (frames == 0) frames = *available;
+    if (frames > *available) {
+      throw std::invalid_argument("--frames " + std::to_string(frames) + " asks for more frames than the input has (" +
+                                  std::to_string(*available) + ")");
+    }
+  } else if (frames == 0) {
+    frames = options.default_frames;
+  }
+
+  TrmEncoder encoder(options.encoder);
+  DecoderConfig decoder_config;
+  decoder_config.link = options.encoder;
+  decoder_config.sensitivity = options.sensitivity;
+  decoder_config.panel = parse_panel(options.panel);
+  decoder_config.output_bits = options.output_bits;
+  ReferenceDecoder decoder(decoder_config);
+
+  const int eyes = options.encoder.stereo ? 2 : 1;
+  for (std::int64_t t = 0; t < frames; ++t) {
+    const cv::Mat linear = source->linear_frame(t);
+    for (int eye = 0; eye < eyes; ++eye) {
+      auto start = std::chrono::steady_clock::now();
+      const LinkFrame sent = encoder.encode(linear, t, eye);
+      const double encode_seconds = seconds_since(start);
+      start = std::chrono::steady_clock::now();
+      const DecodedFrame decoded = decoder.decode(sent);
+      const double decode_seconds = seconds_since(start);
+      DecodedView view;
+      view.source = source.get();
+      view.linear_full = &linear;
+      view.sent = &sent;
+      view.decoded = &decoded;
+      view.encode_seconds = encode_seconds;
+      view.decode_seconds = decode_seconds;
+      sink(view);
+    }
+  }
+  return frames;
+}
+
+}  // namespace trm::cli

@@ -1,0 +1,228 @@
+#include "run_report.hpp"
+
+#include "trm/resample.hpp"
+#include "trm/transfer.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <sstream>
+
+namespace trm::cli {
+
+namespace {
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// What an ideal full-rate panel emits for linear frame I: every frame full resolution, driven through
+// the same panel inverse and output quantisation as the decoder.
+cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits) {
+  const double levels = std::ldexp(1.0, output_bits) - 1.0;
+  cv::Mat out(linear.size(), CV_64FC3);
+  for (int y = 0; y < linear.rows; ++y) {
+    const auto* src = linear.ptr<cv::Vec3d>(y);
+    auto* dst = out.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < linear.cols; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = panel.drive_from_linear(src[x][c], c);
+        const double code = std::floor(std::clamp(v, 0.0, 1.0) * levels + 0.5);
+        dst[x][c] = panel.linear_from_drive(code / levels, c);
+      }
+    }
+  }
+  return out;
+}
+
+Json json_number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+}  // namespace
+
+cv::Mat preview_8bit(const cv::Mat& linear_rgb) {
+  cv::Mat out;
+  quantise(to_encoded(linear_rgb, Transfer::Srgb), 8).convertTo(out, CV_8U);
+  return out;
+}
+
+std::int64_t payload_bytes(const FrameMeta& meta) {
+  const std::int64_t bits = static_cast<std::int64_t>(meta.width) * meta.height * 3 * meta.bits;
+  return (bits + 7) / 8;
+}
+
+double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b) {
+  const cv::Mat a = to_encoded(linear_a, Transfer::Srgb);
+  const cv::Mat b = to_encoded(linear_b, Transfer::Srgb);
+  const double sq = cv::norm(a, b, cv::NORM_L2SQR);
+  const double mse = sq / static_cast<double>(a.total() * a.channels());
+  if (mse == 0.0) return std::numeric_limits<double>::infinity();
+  return 10.0 * std::log10(1.0 / mse);
+}
+
+RunRecorder::RunRecorder(const PipelineOptions& options) : options_(options), panel_(parse_panel(options.panel)) {}
+
+cv::Mat RunRecorder::add(const DecodedView& view) {
+  const DecodedFrame& d = *view.decoded;
+  const FrameMeta& meta = view.sent->meta;
+  full_width_ = meta.full_width;
+  full_height_ = meta.full_height;
+  FrameMeta full_meta = meta;
+  full_meta.width = meta.full_width;
+  full_meta.height = meta.full_height;
+  const std::int64_t bytes = payload_bytes(meta);
+  sum_payload_ += static_cast<double>(bytes);
+  sum_full_payload_ += static_cast<double>(payload_bytes(full_meta));
+  if (meta.parity == Parity::Reduced) {
+    reduced_width_ = meta.width;
+    reduced_height_ = meta.height;
+  } else {
+    ++full_views_;
+    sum_clipped_full_ += d.stats.clipped_fraction;
+  }
+  max_residual_ = std::max(max_residual_, d.stats.residual_max_abs);
+  sum_encode_ += view.encode_seconds;
+  sum_decode_ += view.decode_seconds;
+
+  Json rec;
+  rec["t"] = meta.index;
+  rec["eye"] = meta.eye;
+  rec["parity"] = to_string(meta.parity);
+  rec["sent_size"] = {meta.width, meta.height};
+  rec["payload_bytes"] = bytes;
+  rec["clipped_fraction"] = d.stats.clipped_fraction;
+  rec["residual_mean_abs"] = d.stats.residual_mean_abs;
+  rec["residual_max_abs"] = d.stats.residual_max_abs;
+  if (meta.parity == Parity::Reduced) {
+    rec["residual_applied"] = d.stats.residual_applied;
+    rec["mean_motion_weight"] = d.stats.mean_motion_weight;
+    rec["dropped_sum"] = d.stats.dropped_sum;
+  }
+  if (panel_.kind == PanelKind::Lcd) rec["lcd_unreachable_fraction"] = d.stats.lcd_unreachable_fraction;
+  rec["seconds"] = {{"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
+  frames_.push_back(std::move(rec));
+
+  const cv::Mat reference = full_rate_emission(*view.linear_full, panel_, options_.output_bits);
+  EyeHistory& eye = eyes_[meta.eye];
+  cv::Mat perceived;
+  if (meta.index % 2 == 1 && eye.index == meta.index - 1) {
+    perceived = perceived_pair(eye.emitted, d.emitted_linear);
+    last_reference_pair_ = perceived_pair(eye.reference, reference);
+    const double psnr = psnr_encoded(perceived, last_reference_pair_);
+    const double max_abs = cv::norm(perceived, last_reference_pair_, cv::NORM_INF);
+    Json pair;
+    pair["t"] = {meta.index - 1, meta.index};
+    pair["eye"] = meta.eye;
+    pair["psnr_db"] = json_number(psnr);
+    pair["max_abs_linear"] = max_abs;
+    pairs_.push_back(std::move(pair));
+    if (std::isfinite(psnr)) {
+      sum_psnr_ += psnr;
+      min_psnr_ = std::min(min_psnr_, psnr);
+      ++finite_psnr_pairs_;
+    } else {
+      ++exact_pairs_;
+    }
+  }
+  eye.emitted = d.emitted_linear;
+  eye.reference = reference;
+  eye.index = meta.index;
+  return perceived;
+}
+
+Json RunRecorder::report(double wall_seconds) const {
+  Json r;
+  r["tool"] = "trm";
+  Json p;
+  p["source"] = options_.input.empty() ? options_.scene : options_.input;
+  p["size"] = {full_width_, full_height_};
+  p["reduced_size"] = {reduced_width_, reduced_height_};
+  p["refresh_hz"] = options_.refresh_hz;
+  p["reduction"] = options_.encoder.reduction;
+  p["sigma"] = options_.encoder.effective_sigma();
+  p["phase"] = options_.encoder.phase;
+  p["transfer"] = to_string(options_.encoder.transfer);
+  p["resample_space"] = to_string(options_.encoder.resample_space);
+  p["link_bits"] = options_.encoder.bits;
+  p["output_bits"] = options_.output_bits;
+  p["stereo"] = options_.encoder.stereo;
+  p["sensitivity"] = options_.sensitivity;
+  p["panel"] = options_.panel;
+  p["impl"] = options_.impl;
+  p["seed"] = options_.seed;
+  r["parameters"] = p;
+
+  Json s;
+  const auto n = static_cast<double>(frames_.size());
+  s["views"] = frames_.size();
+  s["pixel_ratio"] = sum_full_payload_ > 0 ? sum_payload_ / sum_full_payload_ : 0.0;
+  s["payload_bytes_total"] = sum_payload_;
+  s["mean_clipped_fraction_full"] = full_views_ ? sum_clipped_full_ / static_cast<double>(full_views_) : 0.0;
+  s["max_residual_abs"] = max_residual_;
+  s["pairs"] = pairs_.size();
+  s["pairs_exact"] = exact_pairs_;
+  s["mean_psnr_db"] = finite_psnr_pairs_ ? json_number(sum_psnr_ / static_cast<double>(finite_psnr_pairs_)) : Json(nullptr);
+  s["min_psnr_db"] = finite_psnr_pairs_ ? json_number(min_psnr_) : Json(nullptr);
+  s["mean_seconds"] = {{"encode", n > 0 ? sum_encode_ / n : 0.0}, {"decode", n > 0 ? sum_decode_ / n : 0.0}};
+  s["wall_seconds"] = wall_seconds;
+  r["summary"] = s;
+  r["pairs"] = pairs_;
+  r["frames"] = frames_;
+  return r;
+}
+
+std::string RunRecorder::summary_table() const {
+  const Json s = report(0.0)["summary"];
+  std::ostringstream out;
+  char line[256];
+  auto row = [&](const char* key, const std::string& value) {
+    std::snprintf(line, sizeof line, "  %-34s %s\n", key, value.c_str());
+    out << line;
+  };
+  auto fmt = [&](const char* f, double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, f, v);
+    return std::string(b);
+  };
+  row("views decoded", std::to_string(frames_.size()));
+  row("full / reduced size", std::to_string(full_width_) + "x" + std::to_string(full_height_) + " / " +
+                                 std::to_string(reduced_width_) + "x" + std::to_string(reduced_height_));
+  row("link payload vs full rate", fmt("%.4f", s["pixel_ratio"].get<double>()));
+  row("full frames clipped (mean)", fmt("%.3f %%", 100.0 * s["mean_clipped_fraction_full"].get<double>()));
+  row("max |residual|", fmt("%.4f", max_residual_));
+  std::string psnr = "n/a (no frame pair)";
+  if (finite_psnr_pairs_ > 0) {
+    psnr = fmt("mean %.2f dB", sum_psnr_ / static_cast<double>(finite_psnr_pairs_)) + fmt(", min %.2f dB", min_psnr_);
+    if (exact_pairs_ > 0) psnr += ", " + std::to_string(exact_pairs_) + " pairs exact";
+  } else if (exact_pairs_ > 0) {
+    psnr = "all " + std::to_string(exact_pairs_) + " pairs exact";
+  }
+  row("perceived pair vs full rate (PSNR)", psnr);
+  row("encode / decode per view", fmt("%.1f ms", 1e3 * s["mean_seconds"]["encode"].get<double>()) + " / " +
+                                      fmt("%.1f ms", 1e3 * s["mean_seconds"]["decode"].get<double>()));
+  return out.str();
+}
+
+Progress::Progress(std::int64_t total) : total_(total), start_(now_seconds()), tty_(isatty(STDERR_FILENO) != 0) {}
+
+void Progress::update(std::int64_t done) {
+  const double now = now_seconds();
+  const double elapsed = now - start_;
+  if (elapsed < 2.0 || now - last_print_ < (tty_ ? 0.25 : 5.0)) return;
+  last_print_ = now;
+  printed_ = true;
+  const double rate = static_cast<double>(done) / elapsed;
+  const double eta = rate > 0 ? static_cast<double>(total_ - done) / rate : 0.0;
+  std::fprintf(stderr, "%s[%lld/%lld] %.1f frames/s, %.0f s left%s", tty_ ? "\r" : "", static_cast<long long>(done),
+               static_cast<long long>(total_), rate, eta, tty_ ? "   " : "\n");
+  std::fflush(stderr);
+}
+
+void Progress::finish() {
+  if (printed_ && tty_) std::fprintf(stderr, "\n");
+}
+
+}  // namespace trm::cli

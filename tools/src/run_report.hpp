@@ -1,0 +1,75 @@
+// Collects per-frame records and per-pair perception figures from the pipeline into report.json,
+// and renders the human-readable summary table.
+#pragma once
+
+#include "pipeline.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+
+namespace trm::cli {
+
+using Json = nlohmann::ordered_json;
+
+// Linear RGB in [0, 1] -> 8-bit sRGB preview (RGB order).
+cv::Mat preview_8bit(const cv::Mat& linear_rgb);
+
+// Link payload of one view in bytes: width x height x 3 channels x bits, packed.
+std::int64_t payload_bytes(const FrameMeta& meta);
+
+class RunRecorder {
+ public:
+  explicit RunRecorder(const PipelineOptions& options);
+  // Records one decoded view; returns the perceived pair (linear) when this view completes a pair
+  // (frames 2k and 2k + 1 of one eye), else an empty Mat.
+  cv::Mat add(const DecodedView& view);
+  // The full-rate reference of the most recently completed pair (linear): the panel showing every
+  // frame at full resolution, through the same drive quantisation.
+  const cv::Mat& last_reference_pair() const { return last_reference_pair_; }
+
+  Json report(double wall_seconds) const;
+  std::string summary_table() const;
+  std::int64_t views() const { return static_cast<std::int64_t>(frames_.size()); }
+
+ private:
+  struct EyeHistory {
+    cv::Mat emitted;     // emitted linear light of the previous frame of this eye
+    cv::Mat reference;   // full-rate reference emission of the previous frame
+    std::int64_t index = -1;
+  };
+  PipelineOptions options_;
+  Panel panel_;
+  Json frames_ = Json::array();
+  Json pairs_ = Json::array();
+  std::map<int, EyeHistory> eyes_;
+  cv::Mat last_reference_pair_;
+  int full_width_ = 0, full_height_ = 0, reduced_width_ = 0, reduced_height_ = 0;
+  double sum_full_payload_ = 0, sum_payload_ = 0;
+  double sum_clipped_full_ = 0, max_residual_ = 0, sum_encode_ = 0, sum_decode_ = 0;
+  std::int64_t full_views_ = 0;
+  double sum_psnr_ = 0, min_psnr_ = 1e300;
+  std::int64_t finite_psnr_pairs_ = 0, exact_pairs_ = 0;
+};
+
+// Rough PSNR (dB) between two linear images, measured on their sRGB encodings scaled to [0, 1];
+// +inf when identical.
+double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b);
+
+// Prints a progress line to stderr once the run has taken more than two seconds.
+class Progress {
+ public:
+  explicit Progress(std::int64_t total);
+  void update(std::int64_t done);
+  void finish();
+
+ private:
+  std::int64_t total_;
+  double start_;
+  double last_print_ = 0;
+  bool printed_ = false;
+  bool tty_;
+};
+
+}  // namespace trm::cli
