@@ -58,6 +58,7 @@ double to_encoded(double linear, Transfer transfer) {
   const double l = clamp01(linear);
   if (transfer == Transfer::Gamma22) return std::pow(l, 1.0 / kPureGamma);
   if (l <= kSrgbLinearBreak) return l * kSrgbSlope;
+  if (l == 1.0) return 1.0;  // 1.055 - 0.055 is 1 - 2^-53 in floating point; peak white must stay exact
   return (1.0 + kSrgbOffset) * std::pow(l, 1.0 / kSrgbExponent) - kSrgbOffset;
 }
 

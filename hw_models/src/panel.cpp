@@ -33,13 +33,23 @@ constexpr double kReachedTolerance = 1e-14;
 // v in [0, 1]: the linear root is the quadratic root to full double precision.
 constexpr double kNegligibleQuadratic = 0x1p-80;
 
+// 'text' (built by appending: GCC 12 misreports "literal" + std::string&& under -Wrestrict).
+std::string quoted(std::string_view text) {
+  std::string out("'");
+  out.append(text);
+  out.push_back('\'');
+  return out;
+}
+
 const char* accepted_forms() {
   return "accepted panel specs: 'vive', 'rift', 'generic', 'gamma:G', 'gamma:GR,GG,GB' (gammas > 0), "
          "'lcd', 'lcd:p1,p2,p3,p4,gamma' (finite parameters, gamma > 0)";
 }
 
 [[noreturn]] void reject(const std::string& spec, const std::string& why) {
-  throw std::invalid_argument("invalid panel '" + spec + "': " + why + "; " + accepted_forms());
+  std::string message("invalid panel ");
+  message.append(quoted(spec)).append(": ").append(why).append("; ").append(accepted_forms());
+  throw std::invalid_argument(message);
 }
 
 // Comma-separated finite doubles, every character consumed.
@@ -52,9 +62,9 @@ std::vector<double> parse_numbers(const std::string& spec, std::string_view list
     const char* end = item.data() + item.size();
     const auto [ptr, ec] = std::from_chars(item.data(), end, value);
     if (item.empty() || ec != std::errc() || ptr != end) {
-      reject(spec, "'" + std::string(item) + "' is not a number");
+      reject(spec, quoted(item) + " is not a number");
     }
-    if (!std::isfinite(value)) reject(spec, "parameters must be finite (got '" + std::string(item) + "')");
+    if (!std::isfinite(value)) reject(spec, "parameters must be finite (got " + quoted(item) + ")");
     values.push_back(value);
     if (comma == std::string_view::npos) break;
     list.remove_prefix(comma + 1);
@@ -85,7 +95,8 @@ LcdPanel::Solution LcdPanel::solve(double m, double v_prev) const {
   const double c = p1 * v_prev * v_prev + p3 * v_prev + p4 - m;
 
   const auto in_range = [](double v) { return v >= -kRangeTolerance && v <= 1.0 + kRangeTolerance; };
-  const auto reachable = [](double v) { return Solution{std::clamp(v, 0.0, 1.0), true}; };
+  // Clamps the few-ulp overshoot allowed by in_range; "+ 0.0" turns -0 (from -c / b with c = 0) into +0.
+  const auto reachable = [](double v) { return Solution{std::clamp(v, 0.0, 1.0) + 0.0, true}; };
 
   if (std::abs(a) <= kNegligibleQuadratic * std::abs(b)) {
     // p1 -> 0: the linear solve, the limit of the stable root c / q below.

@@ -108,8 +108,8 @@ TEST(OledPanel, DriveIsTheInverseGammaPerChannel) {
       EXPECT_NEAR(vive.linear_from_drive(v, channel), x, 1e-14);
     }
   }
-  // The channels differ: a grey input gets a slightly different drive per primary.
-  EXPECT_LT(vive.drive_from_linear(0.5, 0), vive.drive_from_linear(0.5, 2));
+  // The channels differ: red has the steepest gamma, so mid grey needs the highest red drive.
+  EXPECT_GT(vive.drive_from_linear(0.5, 0), vive.drive_from_linear(0.5, 2));
   // Out-of-range linear input is clamped to the displayable range.
   EXPECT_EQ(vive.drive_from_linear(1.5, 1), 1.0);
   EXPECT_EQ(vive.drive_from_linear(-0.5, 1), 0.0);
@@ -165,11 +165,14 @@ TEST(LcdPanel, ExactlyLinearMergeUsesTheLinearSolve) {
   // p1 = 0: M = p2 vt vp + p3 (vt + vp) + p4, linear in vt.
   const LcdPanel lcd = lcd_with(0.0, 0.1, 0.45, 0.02);
   for (double vp : {0.0, 0.3, 1.0}) {
-    for (double m : {0.05, 0.2, 0.4}) {
+    for (double v_true : {0.0, 0.1, 0.5, 0.9, 1.0}) {
+      const double m = lcd.merge(v_true, vp);
       const double linear_root = (m - 0.45 * vp - 0.02) / (0.1 * vp + 0.45);
       const LcdPanel::Solution s = lcd.solve(m, vp);
       EXPECT_TRUE(s.reachable);
-      EXPECT_DOUBLE_EQ(s.v, linear_root);
+      EXPECT_NEAR(s.v, linear_root, 1e-15);
+      EXPECT_NEAR(s.v, v_true, 1e-15);
+      EXPECT_FALSE(std::signbit(s.v));
     }
   }
 }
@@ -180,21 +183,26 @@ TEST(LcdPanel, NearlyLinearMergeHasNoCatastrophicCancellation) {
   for (double p1 : {1e-12, -1e-9, 1e-15, -1e-14}) {
     const LcdPanel lcd = lcd_with(p1, -2.0 * p1, 0.5, 0.0);
     for (double vp : {0.0, 0.2, 0.7, 1.0}) {
-      for (double m : {0.01, 0.25, 0.5, 0.9}) {
-        SCOPED_TRACE(testing::Message() << "p1=" << p1 << " vp=" << vp << " m=" << m);
-        const double linear_root = (m - 0.5 * vp) / 0.5;  // the p1 = 0 solution
+      for (double v_true : {0.05, 0.3, 0.6, 0.95}) {
+        SCOPED_TRACE(testing::Message() << "p1=" << p1 << " vp=" << vp << " v=" << v_true);
+        const double m = lcd.merge(v_true, vp);
+        const double linear_root = (m - 0.5 * vp) / 0.5;  // the p1 = 0 solution for the same m
         const LcdPanel::Solution s = lcd.solve(m, vp);
-        if (linear_root < 0.0 || linear_root > 1.0) {
-          EXPECT_FALSE(s.reachable);
-          continue;
-        }
         EXPECT_TRUE(s.reachable);
+        EXPECT_NEAR(s.v, v_true, 1e-15);
         EXPECT_NEAR(s.v, linear_root, 4.0 * std::abs(p1));  // the root moves by O(p1) only
         EXPECT_NEAR(lcd.merge(s.v, vp), m, 1e-15);
         EXPECT_NEAR(s.v, bisect_monotone(lcd, m, vp), 1e-15);
       }
     }
   }
+  // The check above is sharp enough to see the cancellation it guards against.
+  const double a = 1e-12;
+  const double b = 0.5;
+  const double c = -0.3 * b - a * 0.09;  // root 0.3
+  const double textbook = (-b + std::sqrt(b * b - 4.0 * a * c)) / (2.0 * a);
+  EXPECT_GT(std::abs(textbook - 0.3), 1e-8);
+  EXPECT_NEAR(lcd_with(a, 0.0, 0.5, 0.0).solve(0.5 * 0.3 + a * 0.09, 0.0).v, 0.3, 1e-15);
 }
 
 TEST(LcdPanel, TwoRootsInRangePicksTheBranchContinuousWithTheLinearSolve) {

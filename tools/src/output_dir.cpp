@@ -37,7 +37,10 @@ OutputDir::OutputDir(const fs::path& target) : target_(fs::absolute(target).lexi
   if (ec) throw std::runtime_error("cannot create '" + parent.string() + "': " + ec.message());
   std::random_device rd;
   for (int attempt = 0; attempt < 16; ++attempt) {
-    fs::path candidate = parent / ("." + target_.filename().string() + ".partial-" + std::to_string(rd() % 1000000));
+    // Built with append(): GCC 12 mis-reports operator+ chains on strings under -Wrestrict.
+    std::string name = ".";
+    name.append(target_.filename().string()).append(".partial-").append(std::to_string(rd() % 1000000));
+    const fs::path candidate = parent / name;
     if (fs::create_directory(candidate, ec)) {
       staging_ = candidate;
       return;

@@ -67,6 +67,19 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--sensitivity,-s", sensitivity, "Motion sensitivity s in w = exp(-s c)")->capture_default_str();
   cmd.add_option("--panel", panel, "vive | rift | generic | gamma:G | gamma:GR,GG,GB | lcd | lcd:p1,p2,p3,p4,gamma")
       ->capture_default_str();
+  cmd.add_option_function<std::string>(
+      "--lcd-history",
+      [this](const std::string& s) {
+        if (s == "wanted") {
+          lcd_history = LcdHistory::Wanted;
+        } else if (s == "contributed") {
+          lcd_history = LcdHistory::Contributed;
+        } else {
+          throw CLI::ValidationError("--lcd-history", "expected wanted or contributed, got '" + s + "'");
+        }
+      },
+      "LCD: build each pair target on the previous wanted value (wanted, the design's rule) or on what the "
+      "previous frame actually contributed (contributed)");
   cmd.add_option("--seed", seed, "Seed for scenes with randomness")->capture_default_str();
   cmd.add_option("--impl", impl, "Decoder implementation: reference")->capture_default_str();
 }
@@ -130,6 +143,7 @@ std::int64_t run_pipeline(const PipelineOptions& options, const std::function<vo
   decoder_config.sensitivity = options.sensitivity;
   decoder_config.panel = parse_panel(options.panel);
   decoder_config.output_bits = options.output_bits;
+  decoder_config.lcd_history = options.lcd_history;
   ReferenceDecoder decoder(decoder_config);
 
   const int eyes = options.encoder.stereo ? 2 : 1;

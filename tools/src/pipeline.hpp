@@ -29,6 +29,7 @@ struct PipelineOptions {
   std::string panel = "vive";
   int output_bits = 8;
   std::string impl = "reference";
+  LcdHistory lcd_history = LcdHistory::Wanted;
 
   // Adds the shared options (--scene --input --image --frames --size --refresh --reduction --sigma
   // --phase --transfer --resample-space --bits --stereo --sensitivity --panel --output-bits --seed)

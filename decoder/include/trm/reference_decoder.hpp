@@ -12,12 +12,20 @@
 
 namespace trm {
 
+// Which x_{t-1} the LCD inverse builds frame t's pair target on (DESIGN §4).
+enum class LcdHistory {
+  Wanted,       // the linear value the decoder wanted in frame t-1 (the design's rule; default)
+  Contributed,  // what frame t-1 actually contributed: x_{t-1} where reachable, else 2 M^gamma - x_{t-2}.
+                // Avoids counting an unreachable full frame's shortfall twice (it is already in rho).
+};
+
 struct DecoderConfig {
   EncoderConfig link;          // r, sigma, transfer, bits, resample space: must match the encoder
   double sensitivity = 10.0;   // s in w = exp(-s c) (Eq. 6); s >= 0 (+inf allowed: residual only where c = 0)
   Panel panel;                 // OLED or LCD inverse
   int output_bits = 8;         // drive code depth, 8 or 10
   bool record_stages = false;  // fill DecodedFrame::stages (per-stage vectors for golden tests)
+  LcdHistory lcd_history = LcdHistory::Wanted;
 
   void validate() const;       // throws std::invalid_argument with a clear message
 };
@@ -47,6 +55,7 @@ struct DecodeStages {
   cv::Mat alpha_unclamped;      // reduced with residual: alpha + w rho (Eq. 4) before clamping
   cv::Mat lcd_target;           // LCD: target merged value m = ((x_t + x_{t-1}) / 2)^(1/gamma)
   cv::Mat lcd_previous_drive;   // LCD: v_{t-1} the merge was solved against (quantised drive, as a value)
+  cv::Mat lcd_previous_linear;  // LCD: x_{t-1} the target was built on (see EyeState::previous_wanted)
   cv::Mat lcd_unreachable;      // LCD: 255 where M(v, v_{t-1}) = m had no root in [0, 1] (CV_8UC3)
 };
 
@@ -56,7 +65,8 @@ struct DecodedFrame {
   cv::Mat drive;           // panel drive v in [0, 1] before output quantisation (CV_64FC3)
   cv::Mat drive_codes;     // floor(v (2^output_bits - 1) + 0.5) (CV_16UC3)
   cv::Mat emitted_linear;  // linear light the panel emits in this frame from the quantised drive;
-                           // LCD: the merged value of (v_t, v_{t-1}) raised to gamma
+                           // LCD: the merged value of (v_t, v_{t-1}) raised to gamma, which is already the
+                           // time average of frames t-1 and t (so perceived_pair() applies to OLED only)
   FrameStats stats;
   std::optional<DecodeStages> stages;  // when DecoderConfig::record_stages
 };
@@ -78,7 +88,8 @@ class ReferenceDecoder {
     cv::Mat residual;          // rho_t, full size, signed
     cv::Mat previous_low;      // d_t = Q_b(D(E_t)) codes, reduced size, for the motion test
     cv::Mat previous_drive;    // LCD: v_{t-1} actually shown (quantised drive as a value in [0, 1])
-    cv::Mat previous_wanted;   // LCD: x_{t-1}
+    cv::Mat previous_wanted;   // LCD: x_{t-1}, what frame t-1 contributed in linear light: the wanted value,
+                               // or 2 M(v_{t-1}, v_{t-2})^gamma - x_{t-2} where that was unreachable
   };
   DecoderConfig config_;
   std::map<int, EyeState> eyes_;
