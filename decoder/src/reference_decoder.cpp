@@ -453,7 +453,84 @@ void DecoderConfig::validate() const {
 
 ReferenceDecoder::ReferenceDecoder(DecoderConfig config) : config_(std::move(config)) { config_.validate(); }
 
-DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) {
+namespace {
+
+// Replaces every lost row of codes: by the same row of `substitute` when given, else by the nearest intact row
+// above (or below when there is none above). Returns the number of rows replaced.
+int conceal_rows(cv::Mat& codes, std::span<const std::uint8_t> intact, const cv::Mat& substitute) {
+  int concealed = 0;
+  for (int y = 0; y < codes.rows; ++y) {
+    if (intact[static_cast<std::size_t>(y)]) continue;
+    ++concealed;
+    if (!substitute.empty()) {
+      substitute.row(y).copyTo(codes.row(y));
+      continue;
+    }
+    int source = -1;
+    for (int up = y - 1; up >= 0 && source < 0; --up) {
+      if (intact[static_cast<std::size_t>(up)]) source = up;
+    }
+    for (int down = y + 1; down < codes.rows && source < 0; ++down) {
+      if (intact[static_cast<std::size_t>(down)]) source = down;
+    }
+    codes.row(source).copyTo(codes.row(y));
+  }
+  return concealed;
+}
+
+}  // namespace
+
+DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
+  const cv::Size full(meta.full_width, meta.full_height);
+  EyeState& eye = eyes_[meta.eye];
+  DecodedFrame out;
+  if (eye.full_size == full && !eye.last_output.drive.empty()) {
+    out = eye.last_output;
+    out.stages.reset();
+  } else {
+    eye = EyeState();
+    eye.full_size = full;
+    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
+    out.drive = cv::Mat::zeros(full, CV_64FC3);
+    out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
+    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
+  }
+  out.meta = meta;
+  out.meta.width = full.width;
+  out.meta.height = full.height;
+  out.stats = FrameStats();
+  out.stats.frame_lost = true;
+  out.stats.concealed_lines = meta.height;
+  // The residual belonged to a pair that is now broken.
+  eye.have_residual = false;
+  eye.residual.release();
+  eye.previous_low.release();
+  return out;
+}
+
+DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
+  if (line_intact.empty()) return decode(frame);
+  if (line_intact.size() != static_cast<std::size_t>(frame.codes.rows)) {
+    throw std::invalid_argument("ReferenceDecoder: line mask has " + std::to_string(line_intact.size()) +
+                                " entries for a view of " + std::to_string(frame.codes.rows) + " lines");
+  }
+  const auto intact_lines = std::count_if(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
+  if (intact_lines == 0) return decode_lost(frame.meta);
+  if (intact_lines == frame.codes.rows) return decode(frame);
+
+  LinkFrame concealed{frame.meta, frame.codes.clone()};
+  const EyeState& eye = eyes_[frame.meta.eye];
+  const bool reduced = frame.meta.parity == Parity::Reduced;
+  const bool have_low = reduced && eye.have_residual && eye.previous_low.size() == frame.codes.size();
+  const int lines = conceal_rows(concealed.codes, line_intact, have_low ? eye.previous_low : cv::Mat());
+  DecodedFrame out = decode_view(concealed, line_intact);
+  out.stats.concealed_lines = lines;
+  return out;
+}
+
+DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) { return decode_view(frame, {}); }
+
+DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
   check_link_frame(frame, config_);
   const FrameMeta& meta = frame.meta;
   const EncoderConfig& link = config_.link;
@@ -478,7 +555,11 @@ DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) {
     const cv::Mat low_codes = reduce_codes(frame.codes, link);         // d_t, as the encoder sends it
     const cv::Mat low_linear = upsampled_linear(low_codes, full, link);  // L_t
     const cv::Mat full_linear = linear_from_codes(frame.codes, link);    // I_t
-    const cv::Mat beta = compensate(full_linear, low_linear);            // Eq. 2
+    cv::Mat beta = compensate(full_linear, low_linear);                  // Eq. 2
+    // Concealment: a lost line has no trustworthy beta; it shows L_t (within [0, 1], so its rho is 0).
+    for (int y = 0; y < static_cast<int>(line_intact.size()); ++y) {
+      if (!line_intact[static_cast<std::size_t>(y)]) low_linear.row(y).copyTo(beta.row(y));
+    }
     cv::Mat residual;
     const std::size_t clipped = split_displayable(beta, wanted, residual);
 
@@ -565,6 +646,7 @@ DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) {
   out.drive = drive.drive;
   out.drive_codes = drive.codes;
   out.emitted_linear = drive.emitted_linear;
+  eye.last_output = out;
   if (config_.record_stages) out.stages = std::move(stages);
   return out;
 }

@@ -1,6 +1,7 @@
 // `trm run`: the main job. Renders a scene (or reads an input), runs the GPU-side encoder and the decoder,
 // and writes report.json plus PNG previews of the first frame pair into the output directory.
 #include "commands.hpp"
+#include "link_report.hpp"
 #include "output_dir.hpp"
 #include "pipeline.hpp"
 #include "run_report.hpp"
@@ -38,6 +39,7 @@ void register_run(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand("run", "Run the whole chain on a scene or input and write a report (default: "
                                             "discs, 1080x1200, 90 Hz, r = 1/2, vive OLED)");
   options->add_options(*cmd);
+  options->add_link_options(*cmd);
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   action = nullptr;
   cmd->callback([options, out, &action] {
@@ -54,7 +56,11 @@ void register_run(CLI::App& app, Action& action) {
       std::int64_t done = 0;
       cv::Mat first_full_shown;
       LinkFrame first_full_sent;
-      run_pipeline(*options, [&](const DecodedView& view) {
+      PipelineOptions run_options = *options;
+      if (run_options.link_enabled() && run_options.capture_out.empty()) {
+        run_options.capture_out = dir.file("link.trmcap").string();  // moves into place with the rest
+      }
+      const PipelineResult result = run_pipeline(run_options, [&](const DecodedView& view) {
         const cv::Mat perceived = recorder.add(view);
         const FrameMeta& meta = view.sent->meta;
         if (!previews_written && meta.eye == 0) {
@@ -75,10 +81,16 @@ void register_run(CLI::App& app, Action& action) {
       });
       progress.finish();
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      dir.write_text("report.json", recorder.report(wall).dump(2) + "\n");
+      Json report = recorder.report(wall);
+      std::string link_lines;
+      if (result.link) {
+        report["link"] = write_link_outputs(dir, *options, *result.link, recorder.full_width(), recorder.full_height());
+        link_lines = link_summary_lines(*result.link);
+      }
+      dir.write_text("report.json", report.dump(2) + "\n");
       dir.commit();
       std::cout << "trm run: " << (options->input.empty() ? options->scene : options->input) << "\n"
-                << recorder.summary_table() << "  wrote " << dir.target().string() << "/ (report.json"
+                << recorder.summary_table() << link_lines << "  wrote " << dir.target().string() << "/ (report.json"
                 << (previews_written ? ", pair_*.png previews" : "") << ") in " << wall << " s\n";
       return 0;
     };

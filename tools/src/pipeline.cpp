@@ -1,5 +1,7 @@
 #include "pipeline.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -16,6 +18,20 @@ bool looks_like_image_sequence(const std::string& input) {
     if (ext == e) return true;
   }
   return false;
+}
+
+// Stored in a capture's header so that `trm decode --capture` can rebuild the decoder's link configuration.
+std::string capture_metadata(const PipelineOptions& options) {
+  nlohmann::ordered_json meta;
+  meta["reduction"] = options.encoder.reduction;
+  meta["sigma"] = options.encoder.effective_sigma();
+  meta["phase"] = options.encoder.phase;
+  meta["transfer"] = to_string(options.encoder.transfer);
+  meta["resample_space"] = to_string(options.encoder.resample_space);
+  meta["bits"] = options.encoder.bits;
+  meta["stereo"] = options.encoder.stereo;
+  meta["refresh_hz"] = options.refresh_hz;
+  return meta.dump();
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -84,6 +100,48 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--impl", impl, "Decoder implementation: reference")->capture_default_str();
 }
 
+void PipelineOptions::add_link_options(CLI::App& cmd) {
+  cmd.add_option("--link", link_preset,
+                 "Simulate a display link: dp1.2, dp1.4, dp2.1-uhbr10, dp2.1-uhbr13.5, dp2.1-uhbr20, hdmi2.0, hdmi2.1, "
+                 "wigig[:GBPS], usb3-gen1, usb3-gen2, custom:RATE_GBPS:EFFICIENCY");
+  cmd.add_flag("--cvt-blanking", cvt_blanking, "Count CVT-RB v2 blanking against the frame period");
+  cmd.add_option("--codec", codec, "Link payload coding: raw or jpegls (lossless, per packet slice)")
+      ->capture_default_str();
+  cmd.add_option("--lines-per-packet", lines_per_packet, "Whole lines per packet (jpegls: lines per slice)")
+      ->capture_default_str();
+  cmd.add_option("--ber", ber, "Random bit error rate on the link, e.g. 1e-6");
+  cmd.add_option("--burst", burst, "Burst errors RATE:LENGTH_BITS, e.g. 1e-7:64");
+  cmd.add_option("--drop", drop, "Probability that a packet is lost");
+  cmd.add_option("--capture-out", capture_out, "Write the packet stream as sent to this .trmcap file");
+}
+
+link::LinkSimulationConfig PipelineOptions::link_config(int full_width, int full_height) const {
+  link::LinkSimulationConfig config;
+  if (codec == "raw") {
+    config.packetizer.coding = link::PayloadCoding::Raw;
+  } else if (codec == "jpegls") {
+    config.packetizer.coding = link::PayloadCoding::JpegLs;
+  } else {
+    throw std::invalid_argument("unknown --codec '" + codec + "' (expected raw or jpegls)");
+  }
+  config.packetizer.max_lines_per_packet = lines_per_packet;
+  config.packetizer.validate();
+  config.budget.preset = link::parse_link_preset(link_preset.empty() ? "dp1.4" : link_preset);
+  config.budget.refresh_hz = refresh_hz;
+  if (cvt_blanking) {
+    // Stereo views travel side by side in one video frame.
+    config.budget.blanking =
+        link::cvt_rb_v2_timing(encoder.stereo ? 2 * full_width : full_width, full_height, refresh_hz);
+  }
+  config.budget.validate();
+  config.faults.bit_error_rate = ber;
+  if (!burst.empty()) config.faults.burst = link::parse_burst(burst);
+  config.faults.drop_probability = drop;
+  config.faults.seed = seed;
+  config.faults.validate();
+  return config;
+}
+
 void PipelineOptions::validate() const {
   encoder.validate();
   if (!(std::isfinite(sensitivity) && sensitivity >= 0.0)) {
@@ -98,6 +156,7 @@ void PipelineOptions::validate() const {
     throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference)");
   }
   (void)parse_panel(panel);
+  if (link_enabled()) (void)link_config(width, height);
   if (input.empty()) {
     bool known = false;
     for (const auto& name : scene_names()) known = known || name == scene;
@@ -109,7 +168,7 @@ void PipelineOptions::validate() const {
   }
 }
 
-std::int64_t run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink) {
+PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink) {
   options.validate();
   std::unique_ptr<FrameSource> source;
   if (!options.input.empty()) {
@@ -146,27 +205,69 @@ std::int64_t run_pipeline(const PipelineOptions& options, const std::function<vo
   decoder_config.lcd_history = options.lcd_history;
   ReferenceDecoder decoder(decoder_config);
 
+  std::optional<link::LinkSimulation> simulation;
+  PipelineResult result;
+  if (options.link_enabled()) {
+    link::LinkSimulationConfig config = options.link_config(source->width(), source->height());
+    if (!options.capture_out.empty()) {
+      config.capture = options.capture_out;
+      config.capture_metadata = capture_metadata(options);
+    }
+    simulation.emplace(std::move(config));
+    result.link.emplace();
+  }
+
   const int eyes = options.encoder.stereo ? 2 : 1;
+  std::vector<LinkFrame> sent(static_cast<std::size_t>(eyes));
+  std::vector<double> encode_seconds(static_cast<std::size_t>(eyes));
   for (std::int64_t t = 0; t < frames; ++t) {
     const cv::Mat linear = source->linear_frame(t);
     for (int eye = 0; eye < eyes; ++eye) {
-      auto start = std::chrono::steady_clock::now();
-      const LinkFrame sent = encoder.encode(linear, t, eye);
-      const double encode_seconds = seconds_since(start);
-      start = std::chrono::steady_clock::now();
-      const DecodedFrame decoded = decoder.decode(sent);
-      const double decode_seconds = seconds_since(start);
+      const auto start = std::chrono::steady_clock::now();
+      sent[static_cast<std::size_t>(eye)] = encoder.encode(linear, t, eye);
+      encode_seconds[static_cast<std::size_t>(eye)] = seconds_since(start);
+    }
+    std::vector<link::ReceivedFrame> received;
+    if (simulation) received = simulation->carry(t, sent);
+    for (int eye = 0; eye < eyes; ++eye) {
+      const LinkFrame& view_sent = sent[static_cast<std::size_t>(eye)];
+      const auto start = std::chrono::steady_clock::now();
+      DecodedFrame decoded;
+      if (simulation) {
+        const link::ReceivedFrame* arrived = nullptr;
+        for (const auto& r : received) {
+          if (r.meta.eye == eye && r.meta.index == t) arrived = &r;
+        }
+        if (arrived) {
+          decoded = decoder.decode(LinkFrame{arrived->meta, arrived->codes}, arrived->line_intact);
+        } else {
+          decoded = decoder.decode_lost(view_sent.meta);
+          ++result.link->lost_views;
+        }
+        result.link->concealed_lines += decoded.stats.concealed_lines;
+      } else {
+        decoded = decoder.decode(view_sent);
+      }
       DecodedView view;
       view.source = source.get();
       view.linear_full = &linear;
-      view.sent = &sent;
+      view.sent = &view_sent;
       view.decoded = &decoded;
-      view.encode_seconds = encode_seconds;
-      view.decode_seconds = decode_seconds;
+      view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];
+      view.decode_seconds = seconds_since(start);
       sink(view);
     }
   }
-  return frames;
+  result.frames = frames;
+  if (simulation) {
+    simulation->finish();
+    result.link->frames = simulation->meter().frames();
+    result.link->summary = simulation->meter().summary();
+    result.link->receiver = simulation->receiver_counters();
+    result.link->faults = simulation->fault_counters();
+    result.link->budget = simulation->meter().budget();
+  }
+  return result;
 }
 
 }  // namespace trm::cli

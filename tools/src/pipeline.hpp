@@ -3,6 +3,7 @@
 #pragma once
 
 #include "trm/encoder.hpp"
+#include "trm/link_simulation.hpp"
 #include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
 
@@ -31,6 +32,24 @@ struct PipelineOptions {
   std::string impl = "reference";
   LcdHistory lcd_history = LcdHistory::Wanted;
 
+  // Simulated display link (off when link_preset is empty and no fault or capture is asked for).
+  std::string link_preset;            // dp1.2 ... custom:RATE:EFF
+  bool cvt_blanking = false;          // subtract CVT-RB v2 blanking from the time a frame may use
+  std::string codec = "raw";          // raw | jpegls
+  int lines_per_packet = 1;
+  double ber = 0.0;
+  std::string burst;                  // RATE:LENGTH
+  double drop = 0.0;
+  std::string capture_out;            // write the packet stream as sent
+  bool link_enabled() const {
+    return !link_preset.empty() || ber > 0.0 || !burst.empty() || drop > 0.0 || !capture_out.empty();
+  }
+  // Adds --link --cvt-blanking --codec --lines-per-packet --ber --burst --drop --capture-out.
+  void add_link_options(CLI::App& cmd);
+  // The link configuration these options describe (validated); the preset defaults to dp1.4 when only
+  // faults or a capture were asked for.
+  link::LinkSimulationConfig link_config(int full_width, int full_height) const;
+
   // Adds the shared options (--scene --input --image --frames --size --refresh --reduction --sigma
   // --phase --transfer --resample-space --bits --stereo --sensitivity --panel --output-bits --seed)
   // to a subcommand.
@@ -49,8 +68,22 @@ struct DecodedView {
   double decode_seconds = 0.0;
 };
 
-// Runs source -> encoder -> decoder for every frame and eye, calling sink for each view in order.
-// Returns the number of link frames processed.
-std::int64_t run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink);
+struct LinkOutcome {
+  std::vector<link::LinkFrameUsage> frames;
+  link::BandwidthSummary summary;
+  link::ReceiverCounters receiver;
+  link::FaultCounters faults;
+  link::LinkBudget budget;
+  std::int64_t concealed_lines = 0;
+  std::int64_t lost_views = 0;
+};
+
+struct PipelineResult {
+  std::int64_t frames = 0;            // link frames (time steps) processed
+  std::optional<LinkOutcome> link;    // when the link was simulated
+};
+
+// Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order.
+PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink);
 
 }  // namespace trm::cli

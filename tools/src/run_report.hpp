@@ -32,6 +32,8 @@ class RunRecorder {
   Json report(double wall_seconds) const;
   std::string summary_table() const;
   std::int64_t views() const { return static_cast<std::int64_t>(frames_.size()); }
+  int full_width() const { return full_width_; }
+  int full_height() const { return full_height_; }
 
  private:
   struct EyeHistory {

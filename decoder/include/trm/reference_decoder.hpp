@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <span>
+#include <vector>
 
 namespace trm {
 
@@ -39,6 +41,8 @@ struct FrameStats {
   double mean_motion_weight = 1.0;     // reduced frame: mean w
   bool residual_applied = false;       // reduced frame: a residual from a preceding full frame was used
   double lcd_unreachable_fraction = 0.0;
+  int concealed_lines = 0;             // lines of the received view that were lost and concealed
+  bool frame_lost = false;             // nothing of this view arrived: the previous output was held
 };
 
 // Per-stage intermediates of one decoded frame (DESIGN §4 notation). Matrices that do not apply to the frame
@@ -79,6 +83,15 @@ class ReferenceDecoder {
   // when the frame does not match the configuration (bits, transfer, size, codes out of range). A reduced
   // frame uses the residual only when the eye's previous frame was the full frame with index t - 1.
   DecodedFrame decode(const LinkFrame& frame);
+  // The same for a view received over a faulty link: line_intact holds one entry per line of frame.codes
+  // (0 = lost). Concealment: a lost line of a full frame shows the upsampled low-pass estimate U(d_t) and its
+  // residual is cleared; a lost line of a reduced frame repeats the matching line of the stored d_t (or the
+  // nearest intact line when there is none). Lost lines feed D as copies of the nearest intact line above
+  // (else below). A view with no intact line is decoded as decode_lost().
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  // A view that never arrived: the panel holds this eye's previous output (black if none), and the residual is
+  // dropped, so the next reduced frame adds none (DESIGN §4: a reduced frame after a lost frame adds nothing).
+  DecodedFrame decode_lost(const FrameMeta& meta);
 
  private:
   struct EyeState {
@@ -88,9 +101,13 @@ class ReferenceDecoder {
     cv::Mat residual;          // rho_t, full size, signed
     cv::Mat previous_low;      // d_t = Q_b(D(E_t)) codes, reduced size, for the motion test
     cv::Mat previous_drive;    // LCD: v_{t-1} actually shown (quantised drive as a value in [0, 1])
+    DecodedFrame last_output;  // what this eye showed last, held when a view is lost
     cv::Mat previous_wanted;   // LCD: x_{t-1}, what frame t-1 contributed in linear light: the wanted value,
                                // or 2 M(v_{t-1}, v_{t-2})^gamma - x_{t-2} where that was unreachable
   };
+  // Decodes a view whose lost lines (line_intact[y] == 0; empty: none lost) were already filled in.
+  DecodedFrame decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+
   DecoderConfig config_;
   std::map<int, EyeState> eyes_;
 };

@@ -1,0 +1,99 @@
+// Bandwidth accounting per link frame: bits on the wire, time on the wire, fit in the frame period.
+#pragma once
+
+#include "trm/link.hpp"
+#include "trm/presets.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace trm::link {
+
+// What a link frame may use: the preset's data rate for one frame period at the refresh rate, less the
+// blanking time of the panel's video timing when one is given (CVT-RB v2, option).
+struct LinkBudget {
+  LinkPreset preset;
+  double refresh_hz = 90.0;
+  std::optional<VideoTiming> blanking;  // nullopt: the whole period carries data
+
+  void validate() const;  // throws std::invalid_argument (refresh <= 0, data rate <= 0)
+  double frame_period_seconds() const { return 1.0 / refresh_hz; }
+  double available_seconds() const;       // period * active fraction
+  double capacity_bits_per_frame() const;  // data rate * available time
+};
+
+struct LinkFrameUsage {
+  std::int64_t index = 0;       // link frame t
+  int views = 0;                // 1 mono, 2 stereo
+  std::string parities;         // per view in stream order: "F", "R", "FR", "RF"
+  ViewBits bits;                // summed over the views
+  double wire_seconds = 0.0;    // (payload + overhead) bits / data rate
+  double available_seconds = 0.0;
+  double utilisation = 0.0;     // wire / available
+  bool fits = false;
+};
+
+struct BandwidthSummary {
+  std::int64_t link_frames = 0;
+  std::uint64_t peak_wire_bits = 0;
+  double average_wire_bits = 0.0;
+  std::uint64_t peak_payload_bits = 0;
+  double average_payload_bits = 0.0;
+  std::uint64_t total_pixel_bits = 0;
+  std::uint64_t total_payload_bits = 0;
+  std::uint64_t total_overhead_bits = 0;
+  double peak_utilisation = 0.0;
+  double average_utilisation = 0.0;
+  std::int64_t frames_not_fitting = 0;
+  bool fits = true;
+  // The data rate (after coding) the peak link frame needs, Gbit/s: peak wire bits / available time.
+  double required_data_gbps = 0.0;
+  // The slowest built-in preset the peak link frame fits, or nullopt if none does.
+  std::optional<LinkPreset> minimum_preset;
+};
+
+class BandwidthMeter {
+ public:
+  explicit BandwidthMeter(LinkBudget budget);
+  const LinkBudget& budget() const { return budget_; }
+
+  // Accounts link frame `index` made of these views (one per stream, in stream order).
+  const LinkFrameUsage& add(std::int64_t index, std::span<const SentView> views);
+  // The same from bit counts alone (e.g. predicted full-rate views).
+  const LinkFrameUsage& add(std::int64_t index, const std::string& parities, const ViewBits& bits, int views);
+
+  const std::vector<LinkFrameUsage>& frames() const { return frames_; }
+  BandwidthSummary summary() const;
+
+ private:
+  LinkBudget budget_;
+  std::vector<LinkFrameUsage> frames_;
+};
+
+// The slowest built-in preset on which `wire_bits` fit in one frame period (less blanking, if given).
+std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double refresh_hz,
+                                                 const std::optional<VideoTiming>& blanking);
+
+// OUT/frames.csv: one row per link frame. Columns:
+// link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,
+// wire_time_s,available_time_s,utilisation,fits
+// Written to a temporary name in the same directory and renamed, so a reader never sees half a file.
+// Throws std::runtime_error naming the path on an I/O failure.
+void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz);
+
+struct PlotSeries {
+  std::string label;
+  std::vector<double> bits_per_frame;  // one value per link frame
+};
+
+// Line plot of bits per link frame over link frame index, one coloured line per series, with a legend
+// and, when capacity_bits > 0, a dashed horizontal line for the link's capacity per frame. PNG, written
+// to a temporary name and renamed. Throws std::runtime_error on an encode or I/O failure.
+void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotSeries> series,
+                         double capacity_bits, const std::string& title);
+
+}  // namespace trm::link

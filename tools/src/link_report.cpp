@@ -1,0 +1,119 @@
+#include "link_report.hpp"
+
+#include "trm/resample.hpp"
+
+#include <cstdio>
+
+namespace trm::cli {
+
+namespace {
+
+// Wire bits per link frame that a configuration would need, predicted from the frame geometry alone
+// (raw coding): the comparison series of the plot.
+std::vector<double> predicted_series(const PipelineOptions& options, const link::PacketizerConfig& packetizer,
+                                     std::int64_t frames, int full_width, int full_height, bool stereo, bool trm) {
+  EncoderConfig config = options.encoder;
+  config.stereo = stereo;
+  const int reduced_width = reduced_size(full_width, config.reduction);
+  const int reduced_height = reduced_size(full_height, config.reduction);
+  std::vector<double> bits;
+  bits.reserve(static_cast<std::size_t>(frames));
+  for (std::int64_t t = 0; t < frames; ++t) {
+    double total = 0;
+    for (int eye = 0; eye < (stereo ? 2 : 1); ++eye) {
+      FrameMeta meta;
+      meta.index = t;
+      meta.eye = eye;
+      meta.parity = trm ? parity_of(t, eye, config) : Parity::Full;
+      meta.full_width = full_width;
+      meta.full_height = full_height;
+      meta.width = meta.parity == Parity::Full ? full_width : reduced_width;
+      meta.height = meta.parity == Parity::Full ? full_height : reduced_height;
+      meta.bits = config.bits;
+      meta.transfer = config.transfer;
+      total += static_cast<double>(link::predict_raw_view_bits(meta, packetizer).wire_bits());
+    }
+    bits.push_back(total);
+  }
+  return bits;
+}
+
+}  // namespace
+
+Json write_link_outputs(const OutputDir& dir, const PipelineOptions& options, const LinkOutcome& outcome,
+                        int full_width, int full_height) {
+  link::write_frames_csv(dir.file("frames.csv"), outcome.frames, options.refresh_hz);
+
+  std::vector<link::PlotSeries> series;
+  std::vector<double> measured;
+  for (const auto& f : outcome.frames) measured.push_back(static_cast<double>(f.bits.wire_bits()));
+  const bool stereo = options.encoder.stereo;
+  series.push_back({std::string("TRM ") + (stereo ? "stereo off-phase" : "mono") + " (this run)", measured});
+  const auto frames = static_cast<std::int64_t>(outcome.frames.size());
+  link::PacketizerConfig raw = options.link_config(full_width, full_height).packetizer;
+  raw.coding = link::PayloadCoding::Raw;
+  series.push_back({std::string("full rate ") + (stereo ? "stereo" : "mono"),
+                    predicted_series(options, raw, frames, full_width, full_height, stereo, false)});
+  series.push_back({std::string("TRM ") + (stereo ? "mono" : "stereo off-phase") + " (raw, predicted)",
+                    predicted_series(options, raw, frames, full_width, full_height, !stereo, true)});
+  link::plot_bits_per_frame(dir.file("link_bits.png"), series, outcome.budget.capacity_bits_per_frame(),
+                            "wire bits per link frame on " + outcome.budget.preset.name);
+
+  const link::BandwidthSummary& s = outcome.summary;
+  Json j;
+  j["preset"] = outcome.budget.preset.name;
+  j["description"] = outcome.budget.preset.description;
+  j["data_gbps"] = outcome.budget.preset.data_gbps();
+  j["cvt_rb_v2_blanking"] = outcome.budget.blanking.has_value();
+  j["capacity_bits_per_frame"] = outcome.budget.capacity_bits_per_frame();
+  j["fits"] = s.fits;
+  j["frames_not_fitting"] = s.frames_not_fitting;
+  j["peak_wire_bits"] = s.peak_wire_bits;
+  j["average_wire_bits"] = s.average_wire_bits;
+  j["peak_utilisation"] = s.peak_utilisation;
+  j["average_utilisation"] = s.average_utilisation;
+  j["total_pixel_bits"] = s.total_pixel_bits;
+  j["total_payload_bits"] = s.total_payload_bits;
+  j["total_overhead_bits"] = s.total_overhead_bits;
+  j["required_data_gbps"] = s.required_data_gbps;
+  j["minimum_preset"] = s.minimum_preset ? Json(s.minimum_preset->name) : Json(nullptr);
+  j["faults"] = {{"packets_seen", outcome.faults.packets_seen},
+                 {"packets_dropped", outcome.faults.packets_dropped},
+                 {"packets_damaged", outcome.faults.packets_damaged},
+                 {"random_bit_errors", outcome.faults.random_bit_errors},
+                 {"bursts", outcome.faults.bursts},
+                 {"burst_bit_errors", outcome.faults.burst_bit_errors}};
+  j["receiver"] = {{"packets_received", outcome.receiver.packets_received},
+                   {"packets_accepted", outcome.receiver.packets_accepted},
+                   {"crc_failures", outcome.receiver.crc_failures},
+                   {"malformed", outcome.receiver.malformed},
+                   {"inconsistent", outcome.receiver.inconsistent},
+                   {"duplicates", outcome.receiver.duplicates},
+                   {"stale", outcome.receiver.stale}};
+  j["concealed_lines"] = outcome.concealed_lines;
+  j["lost_views"] = outcome.lost_views;
+  return j;
+}
+
+std::string link_summary_lines(const LinkOutcome& outcome) {
+  const link::BandwidthSummary& s = outcome.summary;
+  char line[512];
+  std::string out;
+  std::snprintf(line, sizeof line, "  %-34s %s (%.2f Gbit/s): %s, peak %.1f %% of a frame period\n", "link",
+                outcome.budget.preset.name.c_str(), outcome.budget.preset.data_gbps(),
+                s.fits ? "fits" : "DOES NOT FIT", 100.0 * s.peak_utilisation);
+  out += line;
+  std::snprintf(line, sizeof line, "  %-34s %.2f Gbit/s; smallest preset that fits: %s\n", "link rate needed at peak",
+                s.required_data_gbps, s.minimum_preset ? s.minimum_preset->name.c_str() : "none");
+  out += line;
+  if (outcome.faults.packets_dropped + outcome.faults.packets_damaged > 0 || outcome.lost_views > 0) {
+    std::snprintf(line, sizeof line, "  %-34s %llu dropped, %llu damaged packets; %lld lines concealed, %lld views lost\n",
+                  "link faults", static_cast<unsigned long long>(outcome.faults.packets_dropped),
+                  static_cast<unsigned long long>(outcome.faults.packets_damaged),
+                  static_cast<long long>(outcome.concealed_lines), static_cast<long long>(outcome.lost_views));
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace trm::cli
