@@ -19,6 +19,7 @@ packages=(
   zlib1g-dev               # CRC32 for link packets
   libcharls-dev            # JPEG-LS lossless link codec
   umockdev libumockdev-dev # emulated USB/HID devices for rig tests
+  clang libclang-rt-14-dev # libFuzzer for the link receiver
 )
 
 missing=()

@@ -130,11 +130,12 @@ constexpr int128 max_raw(int width, bool is_signed) {
   return shift_left(1, is_signed ? width - 1 : width) - 1;
 }
 
-// Result of the quantisation stage: floor plus rounding increment, or a marker that the value is
-// so large (|value| >= 2^65 target LSBs) that any target of <= 64 bits overflows.
+// Result of the quantisation stage: floor plus rounding increment. A value of 2^65 target LSBs or
+// more overflows every target of <= 64 bits; it is marked `huge` and `raw` then holds only its low
+// 128 bits (all that wrapping needs).
 struct Quantised {
-  int128 raw;         // valid when !huge
-  bool huge;          // value far outside every target range
+  int128 raw;
+  bool huge;
   bool huge_negative;
 };
 
@@ -144,8 +145,9 @@ constexpr Quantised quantise_only(int128 raw_in, int in_frac_bits, int out_frac_
   if (shift <= 0) {
     const int up = -shift;
     // |raw_in| < 2^bits, so |raw_in << up| >= 2^(bits - 1 + up); beyond 2^65 every target overflows.
-    if (magnitude_bits(raw_in) + up > 66) return {0, true, raw_in < 0};
-    return {shift_left(raw_in, up), false, false};
+    const int128 low_bits = up < 128 ? shift_left(raw_in, up) : 0;
+    if (magnitude_bits(raw_in) + up > 66) return {low_bits, true, raw_in < 0};
+    return {low_bits, false, false};
   }
   const bool negative = raw_in < 0;
   int128 kept;
@@ -179,7 +181,6 @@ constexpr int128 apply_overflow(const Quantised& v, const Target& t, SaturationC
   if (counter != nullptr) ++counter->overflows;
   switch (t.overflow) {
     case Overflow::Wrap: {
-      if (v.huge) return 0;  // |value| is a multiple of 2^65 target LSBs only if ... see below
       const uint128 mask = (static_cast<uint128>(1) << t.width) - 1u;
       const uint128 bits = static_cast<uint128>(v.raw) & mask;
       if (t.is_signed && ((bits >> (t.width - 1)) & 1u) != 0) {
@@ -203,3 +204,35 @@ constexpr int128 convert(int128 raw_in, int in_frac_bits, const Target& t, Satur
 
 }  // namespace detail
 }  // namespace trm::fx
+
+namespace trm::fx::detail {
+
+// A finite double as an exact integer mantissa and binary point: value = mantissa * 2^-frac_bits.
+struct DecodedDouble {
+  int128 mantissa;
+  int frac_bits;
+  bool finite;
+};
+
+constexpr DecodedDouble decode_double(double value) {
+  const auto bits = std::bit_cast<std::uint64_t>(value);
+  const bool negative = (bits >> 63) != 0;
+  const int biased_exponent = static_cast<int>((bits >> 52) & 0x7ffu);
+  const std::uint64_t fraction = bits & ((std::uint64_t{1} << 52) - 1u);
+  if (biased_exponent == 0x7ff) return {0, 0, false};  // Inf or NaN
+  // Normal: (2^52 + fraction) * 2^(e - 1075); subnormal: fraction * 2^-1074.
+  const std::uint64_t magnitude = biased_exponent == 0 ? fraction : (fraction | (std::uint64_t{1} << 52));
+  const int frac_bits = biased_exponent == 0 ? 1074 : 1075 - biased_exponent;
+  const auto m = static_cast<int128>(magnitude);
+  return {negative ? -m : m, frac_bits, true};
+}
+
+// 2^e as a double, exact for -1074 <= e <= 1023 (0 below, +Inf above).
+constexpr double pow2(int e) {
+  double result = 1.0;
+  const double step = e >= 0 ? 2.0 : 0.5;
+  for (int i = 0; i < (e >= 0 ? e : -e); ++i) result *= step;
+  return result;
+}
+
+}  // namespace trm::fx::detail

@@ -1,0 +1,156 @@
+// The fixed-point TRM decoder (DESIGN §4-5): the reference algorithm with integer arithmetic only, in two
+// schedules of the same per-pixel arithmetic:
+//   FixedFrameDecoder      frame at a time, stage by stage over whole frames (easy to read);
+//   FixedStreamingDecoder  raster order, one input line in and output lines out through explicit circular line
+//                          buffers and frame stores (the hardware model).
+// Both produce identical bits. Every stage has an explicit Q format, listed in FixedDecoderConfig.
+//
+// Notation: uQi.f is unsigned with i integer and f fraction bits, sQi.f signed (i includes the sign bit).
+// "codes" are link code units (0 .. 2^b - 1); linear light is normalised to [0, 1].
+//
+// Panels: OLED (per-channel gamma) and LCD (the Eq. 7 temporal merge), the latter for merge coefficients that make
+// M(v_t, v_{t-1}) increasing in v_t on [0, 1] (the defaults do; others are rejected).
+#pragma once
+
+#include "trm/fixed_runtime.hpp"
+#include "trm/frame.hpp"
+#include "trm/reference_decoder.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace trm {
+
+struct FixedDecoderConfig {
+  // The algorithm parameters shared with ReferenceDecoder: link (r, sigma, transfer, bits; resample space must be
+  // Encoded), motion sensitivity s, panel, output_bits (8 or 10), lcd_history. record_stages is ignored (no
+  // DecodeStages are filled).
+  DecoderConfig decoder;
+
+  // Linear light I, L, alpha, shown beta, alpha': uQ1.F (the integer bit holds 1.0 exactly). beta = 2I - L is
+  // sQ3.F. F = 24 resolves the darkest OLED drive thresholds ((0.5/255)^2.29 = 6.5e-7 = 11 LSB); F = 16 cannot
+  // tell drive codes 0, 1 and 2 apart (rejected).
+  int linear_frac_bits = 24;
+
+  // D (polyphase Gaussian): taps uQ0.F, per reduced sample summing exactly to 2^F (largest remainder, mirror
+  // symmetric where the taps are). d_t must reproduce the encoder's reduced frame code for code (a differing code
+  // reads as motion, Eq. 5). Measured against the reference over every scene and noise at r in {1, .75, .5, .4, .25}:
+  // Q0.14: 0.064 % of output codes differ, up to 28 LSB; Q0.16: 0.015 %, 7 LSB; Q0.20: 0.004 %, 3 LSB;
+  // Q0.24: 0.0015 %, 1 LSB.
+  int gaussian_tap_frac_bits = 24;
+  // The horizontal D result as the vertical line buffer holds it: codes uQb.F, rounded half to even (RndConv).
+  int gaussian_line_frac_bits = 16;
+
+  // U (bilinear): weights uQ0.F (weight of the lower tap = 2^F - weight of the upper).
+  int bilinear_weight_frac_bits = 16;
+  // U output in code units, uQb.F, rounded (Rnd): the address of the EOTF LUT (b + F <= 24 bits).
+  int upsample_frac_bits = 14;
+  // EOTF LUT after U: uniform segments aligned to link codes, 2^k segments per code step:
+  // (2^b - 1) 2^k + 1 ROM words of uQ1.linear_frac_bits (2041 words at 8 bits). Interpolation error ~h^2/8 |f''|:
+  // 4 segments per code leave ~3 linear LSBs (0.09 % of drive codes differ on the line scene), 8 leave < 1.
+  int eotf_segments_per_code_log2 = 3;
+
+  // The residual frame store rho: signed, saturating, default sQ2.24 (lossless for rho in [-1, 1]).
+  fx::RuntimeFormat residual{2, 24, true, fx::Quant::Rnd, fx::Overflow::Sat};
+
+  // Eq. 5 motion contrast: Rec. 709 luma weights uQ0.F summing exactly to 2^F; 1/(Y_prev + Y_alpha) through a
+  // normalised reciprocal LUT (mantissa in [1, 2), 24 address bits, `reciprocal_entries` ROM words, uQ2.24).
+  int luma_weight_frac_bits = 24;
+  int reciprocal_entries = 1025;
+
+  // Eq. 6 w = exp(-s c): s as uQ8.F (s <= 255, or +inf); x = s c as uQ5.exp_input_frac_bits, split into an integer
+  // part (a 16-word ROM exp(-i), x >= 16 gives w = 0) and a fraction (an interpolated LUT of exp(-f) on [0, 1)
+  // with `exp_entries` words); w = exp(-i) exp(-f) in uQ1.linear_frac_bits.
+  int sensitivity_frac_bits = 16;
+  int exp_input_frac_bits = 20;
+  int exp_entries = 2049;
+
+  // OLED drive: codes from a per-channel threshold ROM (2^output_bits words of uQ1.linear_frac_bits,
+  // T_k = ((k - 1/2)/(2^o - 1))^gamma rounded up to the linear grid) searched by binary comparison: the largest k
+  // with x >= T_k. That is exactly floor(x^(1/gamma) (2^o - 1) + 1/2) for every x on the grid.
+  // The drive value v itself (DecodedFrame::drive, for reports only) comes from an octave-segmented x^(1/gamma)
+  // LUT with `drive_segments_per_octave` segments per octave, uQ1.drive_frac_bits.
+  int drive_frac_bits = 16;
+  int drive_segments_per_octave = 32;
+
+  // LCD (Eq. 7 inverse): p1..p4 as sQ7.linear_frac_bits (|p| <= 16); the target m = ((x_t + x_{t-1})/2)^(1/gamma) from an
+  // octave-segmented LUT with `lcd_segments_per_octave` segments per octave (uQ1.linear_frac_bits; relative error
+  // ~(1/S)^2/8 |f''| x^2/f: 512 keeps it near 1e-7); the code is the largest k whose threshold merge
+  // M((k - 1/2)/(2^o - 1), v_{t-1}) <= m, compared exactly in integers (binary search). Unreachable targets clamp to
+  // code 0 or 2^o - 1 and, for full frames, the linear shortfall (from 2 x 2^o-word ROMs of M(0|1, v_{t-1})^gamma)
+  // joins rho.
+  int lcd_segments_per_octave = 512;
+
+  // Throws std::invalid_argument naming the stage whose format or table is unusable.
+  void validate() const;
+};
+
+// Per-stage event counters of the last decoded frame (channel samples).
+struct FixedStageCounts {
+  std::uint64_t beta_clipped = 0;        // Eq. 2: beta outside [0, 1] (full frames)
+  std::uint64_t residual_saturated = 0;  // rho outside the residual store's range (saturated)
+  std::uint64_t residual_rounded = 0;    // rho not representable exactly in the residual store (rounded)
+  std::uint64_t alpha_clipped = 0;       // Eq. 4: alpha + w rho outside [0, 1] (reduced frames)
+  std::uint64_t weight_underflow = 0;    // Eq. 6: pixels with s c >= 16, w forced to 0
+  std::uint64_t lcd_unreachable = 0;     // LCD: M(v, v_{t-1}) = m had no root in [0, 1]
+};
+
+// One line buffer or frame store of the streaming model.
+struct FixedBufferReport {
+  std::string name;
+  int lines = 0;       // lines (line buffer) or rows (frame store)
+  int samples = 0;     // samples per line (channel samples)
+  int bits = 0;        // bits per sample
+  std::int64_t total_bits() const { return static_cast<std::int64_t>(lines) * samples * bits; }
+};
+
+struct FixedStreamingReport {
+  int full_latency_lines = 0;     // full frame: input lines received before output line y is produced, minus y
+  int reduced_latency_lines = 0;  // reduced frame: same in reduced input lines (output y needs reduced row i1(y))
+  std::vector<FixedBufferReport> buffers;
+};
+
+namespace fixed_detail {
+class FixedDecoderCore;
+}
+
+// Frame-at-a-time schedule.
+class FixedFrameDecoder {
+ public:
+  explicit FixedFrameDecoder(FixedDecoderConfig config);  // validates; throws std::invalid_argument
+  ~FixedFrameDecoder();
+  FixedFrameDecoder(FixedFrameDecoder&&) noexcept;
+  FixedFrameDecoder& operator=(FixedFrameDecoder&&) noexcept;
+
+  const FixedDecoderConfig& config() const;
+  // As ReferenceDecoder::decode: one view, per-eye state; the doubles are the fixed values converted exactly.
+  DecodedFrame decode(const LinkFrame& frame);
+  const FixedStageCounts& last_counts() const;
+
+ private:
+  std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
+};
+
+// Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
+class FixedStreamingDecoder {
+ public:
+  explicit FixedStreamingDecoder(FixedDecoderConfig config);
+  ~FixedStreamingDecoder();
+  FixedStreamingDecoder(FixedStreamingDecoder&&) noexcept;
+  FixedStreamingDecoder& operator=(FixedStreamingDecoder&&) noexcept;
+
+  const FixedDecoderConfig& config() const;
+  DecodedFrame decode(const LinkFrame& frame);
+  const FixedStageCounts& last_counts() const;
+  // Latency and the line buffers / frame stores for a view of the given full size.
+  FixedStreamingReport report(cv::Size full) const;
+
+ private:
+  std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
+};
+
+}  // namespace trm

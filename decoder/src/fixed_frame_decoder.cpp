@@ -1,0 +1,104 @@
+// Frame-at-a-time schedule of the fixed-point decoder: each stage runs over a whole frame before the next, as in
+// the reference decoder, calling the shared per-pixel arithmetic (fixed_kernels.hpp).
+#include "fixed_kernels.hpp"
+
+#include <utility>
+#include <vector>
+
+namespace trm {
+
+using fixed_detail::FixedDecoderCore;
+using fixed_detail::Geometry;
+using fixed_detail::Raw;
+
+namespace {
+
+// d_t = Q_b(D(E_t)) over the whole frame: the horizontal pass on every row, then the vertical pass. The codes carry
+// the exact-tie flag (kTieFlag) as the d_t frame store holds them.
+cv::Mat reduce_whole_frame(const fixed_detail::FixedKernels& kernels, const Geometry& g, const cv::Mat& codes) {
+  const int samples = 3 * g.reduced.width;
+  std::vector<std::vector<Raw>> horizontal(static_cast<std::size_t>(g.full.height), std::vector<Raw>(static_cast<std::size_t>(samples)));
+  for (int y = 0; y < g.full.height; ++y) {
+    const std::uint16_t* row = codes.ptr<std::uint16_t>(y);
+    for (int k = 0; k < g.reduced.width; ++k) {
+      for (int ch = 0; ch < 3; ++ch) {
+        horizontal[static_cast<std::size_t>(y)][static_cast<std::size_t>(3 * k + ch)] =
+            kernels.gaussian_horizontal(row, g.gauss_cols[static_cast<std::size_t>(k)], ch);
+      }
+    }
+  }
+  cv::Mat low(g.reduced, CV_16UC3);
+  std::vector<const Raw*> rows;
+  for (int k = 0; k < g.reduced.height; ++k) {
+    const fixed_detail::PolyphaseTaps& taps = g.gauss_rows[static_cast<std::size_t>(k)];
+    rows.clear();
+    for (int index : taps.index) rows.push_back(horizontal[static_cast<std::size_t>(index)].data());
+    std::uint16_t* out = low.ptr<std::uint16_t>(k);
+    for (int i = 0; i < samples; ++i) out[i] = kernels.gaussian_vertical(rows.data(), taps, i);
+  }
+  return low;
+}
+
+}  // namespace
+
+FixedFrameDecoder::FixedFrameDecoder(FixedDecoderConfig config)
+    : core_(std::make_unique<FixedDecoderCore>(std::move(config))) {}
+FixedFrameDecoder::~FixedFrameDecoder() = default;
+FixedFrameDecoder::FixedFrameDecoder(FixedFrameDecoder&&) noexcept = default;
+FixedFrameDecoder& FixedFrameDecoder::operator=(FixedFrameDecoder&&) noexcept = default;
+const FixedDecoderConfig& FixedFrameDecoder::config() const { return core_->config(); }
+const FixedStageCounts& FixedFrameDecoder::last_counts() const { return core_->last_counts(); }
+
+DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame) {
+  fixed_detail::EyeState& eye = core_->begin(frame, "FixedFrameDecoder");
+  const Geometry& g = core_->kernels().geometry(eye.full_size);
+  fixed_detail::FrameOutput out = core_->start_output(frame);
+  out.full = frame.meta.parity == Parity::Full;
+  core_->begin_lcd(out, eye);
+  const auto row_of = [](const cv::Mat& m, int y) { return m.ptr<std::uint16_t>(y); };
+
+  if (frame.meta.parity == Parity::Full) {
+    const cv::Mat low_store = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t with tie flags
+    cv::Mat low(low_store.size(), CV_16UC3);                                          // d_t codes
+    for (int k = 0; k < low.rows; ++k) {
+      const std::uint16_t* in = low_store.ptr<std::uint16_t>(k);
+      std::uint16_t* out_row = low.ptr<std::uint16_t>(k);
+      for (int i = 0; i < 3 * low.cols; ++i) out_row[i] = fixed_detail::code_of(in[i]);
+    }
+    cv::Mat residual(g.full, CV_32SC3);
+    for (int y = 0; y < g.full.height; ++y) {
+      const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+      for (int x = 0; x < g.full.width; ++x) {
+        core_->full_pixel(out, eye, g, y, x, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
+                          residual.ptr<std::int32_t>(y));
+      }
+    }
+    eye.have_residual = true;
+    eye.residual_index = frame.meta.index;
+    eye.residual = residual;
+    eye.previous_low = low_store;
+    return core_->finish(std::move(out), true, false);
+  }
+
+  const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
+  for (int y = 0; y < g.full.height; ++y) {
+    const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    for (int x = 0; x < g.full.width; ++x) {
+      if (residual_applies) {
+        core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
+                             row_of(eye.previous_low, row.i0), row_of(eye.previous_low, row.i1),
+                             eye.residual.ptr<std::int32_t>(y));
+      } else {
+        core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1), nullptr, nullptr,
+                             nullptr);
+      }
+    }
+  }
+  // The residual serves exactly one reduced frame.
+  eye.have_residual = false;
+  eye.residual.release();
+  eye.previous_low.release();
+  return core_->finish(std::move(out), false, residual_applies);
+}
+
+}  // namespace trm

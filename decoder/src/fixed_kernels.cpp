@@ -1,0 +1,704 @@
+// Configuration checks, ROM generation and the per-pixel stage functions of the fixed-point decoder
+// (DESIGN §4-5). ROM contents are generated here from the double-precision functions; evaluation is integer only.
+#include "fixed_kernels.hpp"
+
+#include "trm/resample.hpp"
+#include "trm/transfer.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace trm {
+namespace {
+
+[[noreturn]] void reject(const std::string& stage, const std::string& why) {
+  throw std::invalid_argument("FixedDecoderConfig: " + stage + ": " + why);
+}
+
+void require_range(const std::string& stage, const char* what, int value, int lo, int hi) {
+  if (value < lo || value > hi) {
+    reject(stage, std::string(what) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                      std::to_string(value));
+  }
+}
+
+// Largest-remainder rounding of non-negative weights (summing to ~1) to integers summing exactly to 2^frac_bits.
+// A mirror-symmetric weight list (taps centred on an integer or half-integer position) stays exactly symmetric:
+// mirror pairs receive their extra units together, an odd unit goes to the centre tap. Exact symmetry keeps the
+// exact half-code ties of symmetric content (a Nyquist checkerboard at r = 1/2) exact, so they can be flagged (see
+// FixedKernels::gaussian_vertical). Otherwise ties go to the lower index, so the result is deterministic.
+std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, int frac_bits) {
+  const std::size_t n = weights.size();
+  const double scale = std::ldexp(1.0, frac_bits);
+  std::vector<std::int64_t> out(n);
+  std::vector<double> remainder(n);
+  std::int64_t total = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double scaled = weights[i] * scale;
+    out[i] = static_cast<std::int64_t>(std::floor(scaled));
+    remainder[i] = scaled - static_cast<double>(out[i]);
+    total += out[i];
+  }
+  bool symmetric = true;
+  for (std::size_t i = 0; i < n / 2; ++i) symmetric = symmetric && weights[i] == weights[n - 1 - i];
+  // Groups of taps that receive units together: {i, mirror(i)} when symmetric, else single taps.
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < (symmetric ? (n + 1) / 2 : n); ++i) {
+    if (symmetric && i != n - 1 - i) groups.push_back({i, n - 1 - i}); else groups.push_back({i});
+  }
+  std::stable_sort(groups.begin(), groups.end(), [&](const auto& a, const auto& b) {
+    return remainder[a.front()] > remainder[b.front()];
+  });
+  std::int64_t missing = (std::int64_t{1} << frac_bits) - total;
+  while (missing > 0) {
+    const std::int64_t before = missing;
+    for (const auto& group : groups) {
+      if (static_cast<std::int64_t>(group.size()) > missing) continue;
+      for (std::size_t i : group) ++out[i];
+      missing -= static_cast<std::int64_t>(group.size());
+      if (missing == 0) break;
+    }
+    if (missing == before) {  // cannot happen for symmetric lists (parity); keeps termination obvious
+      ++out[groups.front().front()];
+      --missing;
+    }
+  }
+  for (std::size_t k = 0; missing < 0; k = (k + 1) % n) {  // only if the doubles summed above 1
+    if (out[k] > 0) {
+      --out[k];
+      ++missing;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void FixedDecoderConfig::validate() const {
+  decoder.validate();
+  const EncoderConfig& link = decoder.link;
+  if (decoder.panel.kind == PanelKind::Lcd) {
+    const LcdPanel& lcd = decoder.panel.lcd;
+    for (double p : {lcd.p1, lcd.p2, lcd.p3, lcd.p4}) {
+      if (std::abs(p) > 16.0) reject("LCD drive", "merge coefficients p1..p4 must be within [-16, 16]");
+    }
+    // dM/dv_t = 2 p1 v_t + p2 v_{t-1} + p3 is linear in both: positive at the four corners means positive on [0, 1]^2.
+    for (double v : {0.0, 1.0}) {
+      for (double vp : {0.0, 1.0}) {
+        if (!(2.0 * lcd.p1 * v + lcd.p2 * vp + lcd.p3 > 0.0)) {
+          reject("LCD drive", "the threshold search needs M(v_t, v_prev) increasing in v_t on [0, 1] (dM/dv_t = "
+                              "2 p1 v_t + p2 v_prev + p3 > 0); these coefficients are not supported in fixed point");
+        }
+      }
+      if (!(2.0 * (2.0 * lcd.p1 + lcd.p2) * v + 2.0 * lcd.p3 > 0.0)) {
+        reject("LCD drive", "the held merge M(v, v) must be increasing on [0, 1]");
+      }
+    }
+    if (lcd_segments_per_octave < 1 || lcd_segments_per_octave > 2048 ||
+        !std::has_single_bit(static_cast<unsigned>(lcd_segments_per_octave))) {
+      reject("LCD drive (target LUT)", "lcd_segments_per_octave must be a power of two in [1, 2048]");
+    }
+  }
+  if (link.resample_space != ResampleSpace::Encoded) {
+    reject("D/U resample space", "the fixed-point decoders resample in the encoded space only");
+  }
+  require_range("linear light", "linear_frac_bits", linear_frac_bits, 8, 28);
+  require_range("D (Gaussian taps)", "gaussian_tap_frac_bits", gaussian_tap_frac_bits, 8, 30);
+  require_range("D (line buffer)", "gaussian_line_frac_bits", gaussian_line_frac_bits, 0, 30);
+  if (link.bits + gaussian_line_frac_bits + gaussian_tap_frac_bits > 62) {
+    reject("D (line buffer)", "codes x taps accumulator exceeds 62 bits (bits + line + tap fraction bits)");
+  }
+  require_range("U (bilinear weights)", "bilinear_weight_frac_bits", bilinear_weight_frac_bits, 4, 24);
+  require_range("U (output)", "upsample_frac_bits", upsample_frac_bits, 0, 24 - link.bits);
+  require_range("U (output)", "upsample_frac_bits", upsample_frac_bits, 0, 2 * bilinear_weight_frac_bits);
+  require_range("EOTF LUT", "eotf_segments_per_code_log2", eotf_segments_per_code_log2, 0, upsample_frac_bits);
+  if ((static_cast<std::int64_t>((1 << link.bits) - 1) << eotf_segments_per_code_log2) + 1 > 65536) {
+    reject("EOTF LUT", "(2^bits - 1) 2^k + 1 entries exceed the 65536-word ROM limit");
+  }
+  if (!residual.is_signed) reject("residual store", "the residual format must be signed (rho is in [-1, 1])");
+  if (!residual.is_valid() || residual.width() > 32 || residual.int_bits < 1 || residual.frac_bits < 1 ||
+      residual.frac_bits > linear_frac_bits) {
+    reject("residual store", "format " + residual.to_string() +
+                                 " must have <= 32 bits, >= 1 integer bit and 1..linear_frac_bits fraction bits");
+  }
+  require_range("motion contrast (luma)", "luma_weight_frac_bits", luma_weight_frac_bits, 8, 30);
+  require_range("motion contrast (reciprocal LUT)", "reciprocal_entries", reciprocal_entries, 65, 65536);
+  const double s = decoder.sensitivity;
+  if (std::isfinite(s) && s > 255.0) {
+    reject("motion weight", "finite sensitivity s must be <= 255 (uQ8 integer part), got " + std::to_string(s));
+  }
+  require_range("motion weight", "sensitivity_frac_bits", sensitivity_frac_bits, 4, 24);
+  require_range("motion weight (exp LUT)", "exp_input_frac_bits", exp_input_frac_bits, 8, 24);
+  require_range("motion weight (exp LUT)", "exp_entries", exp_entries, 65, 65536);
+  require_range("OLED drive", "drive_frac_bits", drive_frac_bits, 8, 30);
+  if (drive_segments_per_octave < 1 || drive_segments_per_octave > 1024 ||
+      !std::has_single_bit(static_cast<unsigned>(drive_segments_per_octave))) {
+    reject("OLED drive (value LUT)", "drive_segments_per_octave must be a power of two in [1, 1024]");
+  }
+  // The threshold ROM must tell every drive code apart: T_1 < T_2 < ... on the linear grid.
+  const int top = (1 << decoder.output_bits) - 1;
+  const std::array<double, 3> gammas = decoder.panel.kind == PanelKind::Oled
+                                           ? decoder.panel.oled.gamma
+                                           : std::array<double, 3>{decoder.panel.lcd.gamma, decoder.panel.lcd.gamma,
+                                                                   decoder.panel.lcd.gamma};
+  for (double gamma : gammas) {
+    const double t1 = std::ceil(std::ldexp(std::pow(0.5 / top, gamma), linear_frac_bits));
+    const double t2 = std::ceil(std::ldexp(std::pow(1.5 / top, gamma), linear_frac_bits));
+    if (!(t1 >= 1.0 && t2 > t1)) {
+      reject("OLED/LCD drive (linear light)", "uQ1." + std::to_string(linear_frac_bits) +
+                                              " is too narrow for " + std::to_string(decoder.output_bits) +
+                                              "-bit drive at gamma " + std::to_string(gamma) +
+                                              ": thresholds of codes 0, 1, 2 collapse");
+    }
+  }
+}
+
+namespace fixed_detail {
+
+FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
+  config_.validate();
+  const EncoderConfig& link = config_.decoder.link;
+  const int F = config_.linear_frac_bits;
+  const fx::RuntimeFormat linear_format{1, F, false, fx::Quant::Rnd, fx::Overflow::Sat};
+  linear_lsb_ = std::ldexp(1.0, -F);
+  drive_lsb_ = std::ldexp(1.0, -config_.drive_frac_bits);
+  residual_lsb_ = std::ldexp(1.0, -config_.residual.frac_bits);
+
+  // I = lin(E): one ROM word per link code.
+  code_rom_.resize(static_cast<std::size_t>(max_code()) + 1);
+  for (int code = 0; code <= max_code(); ++code) {
+    code_rom_[static_cast<std::size_t>(code)] =
+        fx::quantise_double(to_linear(static_cast<double>(code) / max_code(), link.transfer), linear_format);
+  }
+
+  // L = lin(U(d)): the address is U's output in codes uQb.U; segments aligned to code steps make the segment
+  // index and weight plain bit fields of the address.
+  fx::LutShape eotf_shape;
+  eotf_shape.entries = (max_code() << config_.eotf_segments_per_code_log2) + 1;
+  eotf_shape.input_bits = link.bits + config_.upsample_frac_bits;
+  eotf_shape.output_bits = 1 + F;
+  eotf_shape.output_frac_bits = F;
+  const Transfer transfer = link.transfer;
+  eotf_ = std::make_unique<fx::InterpolatedLut>(
+      "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.upsample_frac_bits),
+      [transfer](double t) { return to_linear(t, transfer); });
+
+  // Eq. 5: Rec. 709 weights summing exactly to 2^W; 1/x through the normalised reciprocal LUT (uQ2.24 holds 1.0).
+  const std::vector<std::int64_t> luma =
+      integer_weights({0.2126, 0.7152, 0.0722}, config_.luma_weight_frac_bits);
+  std::copy(luma.begin(), luma.end(), luma_weights_.begin());
+  fx::LutShape reciprocal_shape;
+  reciprocal_shape.entries = config_.reciprocal_entries;
+  reciprocal_shape.input_bits = 24;
+  reciprocal_shape.output_bits = 26;
+  reciprocal_shape.output_frac_bits = 24;
+  reciprocal_ = std::make_unique<fx::InterpolatedLut>(fx::make_reciprocal_lut(reciprocal_shape));
+
+  // Eq. 6: exp(-x) = exp(-floor x) exp(-frac x).
+  const double s = config_.decoder.sensitivity;
+  sensitivity_infinite_ = std::isinf(s);
+  if (!sensitivity_infinite_) {
+    sensitivity_raw_ = fx::quantise_double(s, {8, config_.sensitivity_frac_bits, false, fx::Quant::Rnd, fx::Overflow::Sat});
+  }
+  exp_integer_rom_.resize(16);
+  for (int i = 0; i < 16; ++i) exp_integer_rom_[static_cast<std::size_t>(i)] = fx::quantise_double(std::exp(-i), linear_format);
+  fx::LutShape exp_shape;
+  exp_shape.entries = config_.exp_entries;
+  exp_shape.input_bits = config_.exp_input_frac_bits;
+  exp_shape.output_bits = 1 + F;
+  exp_shape.output_frac_bits = F;
+  exp_fraction_ = std::make_unique<fx::InterpolatedLut>("exp_neg_fraction", exp_shape,
+                                                        std::ldexp(1.0, config_.exp_input_frac_bits),
+                                                        [](double t) { return std::exp(-t); });
+
+  const int top = max_output_code();
+  drive_lut_shift_ = std::max(0, F - 24);
+  const int drive_address_bits = F - drive_lut_shift_;
+  lcd_ = config_.decoder.panel.kind == PanelKind::Lcd;
+  if (lcd_) {
+    // LCD (Eq. 7 inverse): coefficients sQ7.F, the target LUT x^(1/gamma) and the clamped-drive luminance ROMs.
+    const LcdPanel& lcd = config_.decoder.panel.lcd;
+    const fx::RuntimeFormat coefficient{7, F, true, fx::Quant::Rnd, fx::Overflow::Sat};
+    lcd_coefficients_ = {fx::quantise_double(lcd.p1, coefficient), fx::quantise_double(lcd.p2, coefficient),
+                         fx::quantise_double(lcd.p3, coefficient), fx::quantise_double(lcd.p4, coefficient)};
+    lcd_held_coefficients_ = {2 * lcd_coefficients_[0] + lcd_coefficients_[1], 0, 2 * lcd_coefficients_[2],
+                              lcd_coefficients_[3]};
+    const int address_bits = std::min(24, F + 1);
+    fx::LutShape target_shape;
+    target_shape.input_bits = address_bits;
+    target_shape.octaves = address_bits;
+    target_shape.entries = address_bits * config_.lcd_segments_per_octave + 1;
+    target_shape.output_bits = 1 + F;
+    target_shape.output_frac_bits = F;
+    lcd_target_lut_ = std::make_unique<fx::InterpolatedLut>(fx::make_inverse_gamma_lut(lcd.gamma, target_shape));
+    const fx::RuntimeFormat luminance{4, F, true, fx::Quant::Rnd, fx::Overflow::Sat};
+    for (int end = 0; end < 2; ++end) {
+      std::vector<Raw>& rom = lcd_end_luminance_[static_cast<std::size_t>(end)];
+      rom.resize(static_cast<std::size_t>(top) + 1);
+      for (int j = 0; j <= top; ++j) {
+        const double merged = lcd.merge(static_cast<double>(end), static_cast<double>(j) / top);
+        rom[static_cast<std::size_t>(j)] = fx::quantise_double(std::pow(std::max(merged, 0.0), lcd.gamma), luminance);
+      }
+    }
+    return;
+  }
+  // OLED drive: thresholds T_k = ((k - 1/2) / (2^o - 1))^gamma rounded up onto the linear grid, so that x >= T_k on
+  // the grid is exactly x^(1/gamma) (2^o - 1) + 1/2 >= k.
+  for (int ch = 0; ch < 3; ++ch) {
+    const double gamma = config_.decoder.panel.oled.gamma[static_cast<std::size_t>(ch)];
+    std::vector<Raw>& t = thresholds_[static_cast<std::size_t>(ch)];
+    t.resize(static_cast<std::size_t>(top) + 1);
+    t[0] = 0;
+    for (int k = 1; k <= top; ++k) {
+      t[static_cast<std::size_t>(k)] =
+          static_cast<Raw>(std::ceil(std::ldexp(std::pow((k - 0.5) / top, gamma), F)));
+    }
+    fx::LutShape drive_shape;
+    drive_shape.input_bits = drive_address_bits;
+    drive_shape.octaves = drive_address_bits;
+    drive_shape.entries = drive_address_bits * config_.drive_segments_per_octave + 1;
+    drive_shape.output_bits = 1 + config_.drive_frac_bits;
+    drive_shape.output_frac_bits = config_.drive_frac_bits;
+    drive_luts_[static_cast<std::size_t>(ch)] =
+        std::make_unique<fx::InterpolatedLut>(fx::make_inverse_gamma_lut(gamma, drive_shape));
+    std::vector<double>& e = emission_[static_cast<std::size_t>(ch)];
+    e.resize(static_cast<std::size_t>(top) + 1);
+    for (int code = 0; code <= top; ++code) {
+      e[static_cast<std::size_t>(code)] = config_.decoder.panel.linear_from_drive(static_cast<double>(code) / top, ch);
+    }
+  }
+}
+
+const Geometry& FixedKernels::geometry(cv::Size full) {
+  const auto key = std::make_pair(full.width, full.height);
+  const auto found = geometries_.find(key);
+  if (found != geometries_.end()) return found->second;
+  const EncoderConfig& link = config_.decoder.link;
+  Geometry g;
+  g.full = full;
+  g.reduced = cv::Size(reduced_size(full.width, link.reduction), reduced_size(full.height, link.reduction));
+  const double sigma = link.effective_sigma();
+  const auto gauss_axis = [&](int full_n, int reduced_n) {
+    std::vector<PolyphaseTaps> axis(static_cast<std::size_t>(reduced_n));
+    for (int k = 0; k < reduced_n; ++k) {
+      const GaussianTaps taps = gaussian_taps(k, full_n, reduced_n, sigma);
+      PolyphaseTaps& out = axis[static_cast<std::size_t>(k)];
+      out.weight = integer_weights(taps.weights, config_.gaussian_tap_frac_bits);
+      for (std::size_t i = 0; i < taps.weights.size(); ++i) {
+        out.index.push_back(std::clamp(taps.first_index + static_cast<int>(i), 0, full_n - 1));
+      }
+    }
+    return axis;
+  };
+  const auto bilinear_axis = [&](int full_n, int reduced_n) {
+    std::vector<BilinearWeights> axis(static_cast<std::size_t>(full_n));
+    const double scale = std::ldexp(1.0, config_.bilinear_weight_frac_bits);
+    for (int x = 0; x < full_n; ++x) {
+      const BilinearTap tap = bilinear_tap(x, full_n, reduced_n);
+      // frac = num / 2W exactly; 2W <= 2^31 and the scale is a power of two, so the rounding is exact.
+      axis[static_cast<std::size_t>(x)] = {tap.i0, tap.i1, static_cast<Raw>(std::floor(tap.frac * scale + 0.5))};
+    }
+    return axis;
+  };
+  g.gauss_cols = gauss_axis(full.width, g.reduced.width);
+  g.gauss_rows = gauss_axis(full.height, g.reduced.height);
+  g.bilinear_cols = bilinear_axis(full.width, g.reduced.width);
+  g.bilinear_rows = bilinear_axis(full.height, g.reduced.height);
+  return geometries_.emplace(key, std::move(g)).first->second;
+}
+
+Raw FixedKernels::gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const {
+  Raw acc = 0;  // codes x uQ0.T
+  for (std::size_t i = 0; i < taps.weight.size(); ++i) acc += taps.weight[i] * codes_row[3 * taps.index[i] + ch];
+  // uQb.L, half to even: rows a, b with a + b an integer (255 - pattern) keep a + b exact, so an exact half-code
+  // tie of the vertical sum stays exact and is flagged.
+  const int shift = config_.gaussian_tap_frac_bits - config_.gaussian_line_frac_bits;
+  return shift > 0 ? round_convergent_shift(acc, shift) : round_shift(acc, shift);
+}
+
+std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const {
+  Raw acc = 0;  // uQb.(L + T)
+  for (std::size_t j = 0; j < taps.weight.size(); ++j) acc += taps.weight[j] * rows[j][sample];
+  // Q_b: the nearest code, as the encoder's floor(x + 1/2); taps sum to 1, so no clamp is needed.
+  const int shift = config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits;
+  const auto code = static_cast<std::uint16_t>(round_shift(acc, shift));
+  // Exactly half-way: the encoder's double D lands within an ulp of the half and rounds either way.
+  const bool tie = (acc & ((Raw{1} << shift) - 1)) == (Raw{1} << (shift - 1));
+  return static_cast<std::uint16_t>(code | (tie ? kTieFlag : 0));
+}
+
+Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper,
+                        Raw row_upper) const {
+  const Raw unit = Raw{1} << config_.bilinear_weight_frac_bits;
+  const Raw top = (unit - col_upper) * top_left + col_upper * top_right;            // uQb.W
+  const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
+  const Raw blended = (unit - row_upper) * top + row_upper * bottom;               // uQb.2W
+  return round_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_frac_bits);  // uQb.U
+}
+
+Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col,
+                           Raw row_upper, int ch) const {
+  return blend(row0[3 * col.i0 + ch], row0[3 * col.i1 + ch], row1[3 * col.i0 + ch], row1[3 * col.i1 + ch], col.upper,
+               row_upper);
+}
+
+bool FixedKernels::has_tie(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col,
+                           int ch) const {
+  const int a = 3 * col.i0 + ch;
+  const int b = 3 * col.i1 + ch;
+  return ((stored0[a] | stored0[b] | stored1[a] | stored1[b]) & kTieFlag) != 0;
+}
+
+Raw FixedKernels::upsample_stored(const std::uint16_t* stored0, const std::uint16_t* stored1,
+                                  const BilinearWeights& col, Raw row_upper, int ch) const {
+  const int a = 3 * col.i0 + ch;
+  const int b = 3 * col.i1 + ch;
+  return blend(code_of(stored0[a]), code_of(stored0[b]), code_of(stored1[a]), code_of(stored1[b]), col.upper, row_upper);
+}
+
+Raw FixedKernels::upsample_previous(const std::uint16_t* stored0, const std::uint16_t* stored1,
+                                    const std::uint16_t* received0, const std::uint16_t* received1,
+                                    const BilinearWeights& col, Raw row_upper, int ch) const {
+  const int a = 3 * col.i0 + ch;
+  const int b = 3 * col.i1 + ch;
+  return blend(resolve_tie(stored0[a], received0[a]), resolve_tie(stored0[b], received0[b]),
+               resolve_tie(stored1[a], received1[a]), resolve_tie(stored1[b], received1[b]), col.upper, row_upper);
+}
+
+Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
+  return eotf_->evaluate_raw(static_cast<std::uint32_t>(upsampled));
+}
+
+CompensatedSample FixedKernels::compensate(Raw full_linear, Raw low_linear) const {
+  CompensatedSample out;
+  const Raw beta = 2 * full_linear - low_linear;  // Eq. 2: beta = 2 I - L, sQ3.F
+  out.shown = std::clamp(beta, Raw{0}, one());
+  out.clipped = out.shown != beta;
+  out.rho = beta - out.shown;  // sQ2.F in [-1, 1]
+  return out;
+}
+
+StoredResidual FixedKernels::store_residual(Raw rho) const {
+  StoredResidual out;
+  if (rho == 0) return out;  // zero in every format (the common case: beta within [0, 1])
+  fx::SaturationCounter saturation;
+  out.value = fx::quantise_raw(rho, config_.linear_frac_bits, config_.residual, &saturation);
+  out.saturated = saturation.overflows != 0;
+  out.rounded = !out.saturated && round_shift(out.value, config_.residual.frac_bits - config_.linear_frac_bits) != rho;
+  return out;
+}
+
+Raw FixedKernels::scaled_merge(const std::array<Raw, 4>& p, Raw t, Raw j) const {
+  // M(T, vp) with T = t / (2 Mx), vp = 2 j / (2 Mx), times (2 Mx)^2: every term is an exact integer.
+  const Raw two_top = 2 * static_cast<Raw>(max_output_code());
+  const Raw vp2 = 2 * j;
+  return p[0] * (t * t + vp2 * vp2) + p[1] * (t * vp2) + p[2] * (two_top * (t + vp2)) + p[3] * (two_top * two_top);
+}
+
+Raw FixedKernels::lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const {
+  // v between the thresholds around `code`, interpolated linearly in M (reports only; the code is exact).
+  const Raw two_top = 2 * static_cast<Raw>(max_output_code());
+  const Raw t_lo = std::max<Raw>(0, 2 * code - 1);
+  const Raw t_hi = std::min<Raw>(two_top, 2 * code + 1);
+  const Raw m_lo = scaled_merge(p, t_lo, j);
+  const Raw m_hi = scaled_merge(p, t_hi, j);
+  const fx::detail::int128 span = m_hi - m_lo;
+  if (span <= 0) return (t_lo << config_.drive_frac_bits) / two_top;  // coefficients quantised to a flat merge
+  const fx::detail::int128 offset = std::clamp<fx::detail::int128>(target_scaled - m_lo, 0, span);
+  const fx::detail::int128 numerator = (static_cast<fx::detail::int128>(t_lo) * span + offset * (t_hi - t_lo))
+                                       << config_.drive_frac_bits;
+  const fx::detail::int128 denominator = span * two_top;
+  return static_cast<Raw>((numerator + denominator / 2) / denominator);
+}
+
+LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const {
+  const int F = config_.linear_frac_bits;
+  const int top = max_output_code();
+  const Raw two_top = 2 * static_cast<Raw>(top);
+  LcdSample out;
+  // m = ((x_t + x_{t-1}) / 2)^(1/gamma): the sum is the average in uQ1.(F+1); the LUT takes its top 24 bits.
+  const Raw sum = held ? 2 * wanted : wanted + previous_wanted;
+  Raw target = 0;
+  if (sum >= (Raw{1} << (F + 1))) {
+    target = one();
+  } else if (sum > 0) {
+    const int shift = F + 1 - lcd_target_lut_->shape().input_bits;
+    target = lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> shift));
+  }
+  const Raw target_scaled = target * (two_top * two_top);  // m (2 Mx)^2 2^F, as scaled_merge
+  const auto search = [&](const std::array<Raw, 4>& p, Raw j) {
+    int lo = 0;
+    int hi = top;
+    while (lo < hi) {  // the largest k with M(T_k, vp) <= m (M increases with T)
+      const int mid = (lo + hi + 1) / 2;
+      if (target_scaled >= scaled_merge(p, 2 * static_cast<Raw>(mid) - 1, j)) lo = mid; else hi = mid - 1;
+    }
+    return lo;
+  };
+  // First frame of the eye: the pixel is taken as held at x_t (M(v, v) = x_t^(1/gamma), the same m).
+  const Raw j = held ? search(lcd_held_coefficients_, 0) : previous_code;
+  const Raw x_previous = held ? wanted : previous_wanted;
+  out.previous_code = static_cast<std::uint16_t>(j);
+  out.contributed = wanted;
+  const bool below = target_scaled < scaled_merge(lcd_coefficients_, 0, j);
+  const bool above = target_scaled > scaled_merge(lcd_coefficients_, two_top, j);
+  if (below || above) {
+    // No root in [0, 1]: v clamps to the nearer end; frame t contributes x_eff = 2 M(v, v_prev)^gamma - x_{t-1}.
+    out.unreachable = true;
+    out.code = static_cast<std::uint16_t>(above ? top : 0);
+    out.drive = above ? Raw{1} << config_.drive_frac_bits : 0;
+    const Raw x_effective = 2 * lcd_end_luminance_[above ? 1 : 0][static_cast<std::size_t>(j)] - x_previous;
+    out.shortfall = wanted - x_effective;
+    out.contributed = x_effective;
+    return out;
+  }
+  out.code = static_cast<std::uint16_t>(search(lcd_coefficients_, j));
+  out.drive = lcd_drive_value(lcd_coefficients_, target_scaled, out.code, j);
+  return out;
+}
+
+double FixedKernels::lcd_emitted(std::uint16_t code, std::uint16_t previous_code) const {
+  const LcdPanel& lcd = config_.decoder.panel.lcd;
+  const double top = max_output_code();
+  return std::pow(std::max(lcd.merge(code / top, previous_code / top), 0.0), lcd.gamma);
+}
+
+Raw FixedKernels::luma(const Raw* rgb) const {
+  const Raw sum = luma_weights_[0] * rgb[0] + luma_weights_[1] * rgb[1] + luma_weights_[2] * rgb[2];
+  return round_shift(sum, config_.luma_weight_frac_bits);  // uQ1.F
+}
+
+Raw FixedKernels::motion_weight(Raw luma_previous, Raw luma_alpha, bool& underflow) const {
+  underflow = false;
+  const int F = config_.linear_frac_bits;
+  const Raw sum = luma_previous + luma_alpha;  // uQ2.F
+  const Raw difference = luma_previous > luma_alpha ? luma_previous - luma_alpha : luma_alpha - luma_previous;
+  if (difference == 0) return one();  // c = 0 (including a zero sum): w = 1 exactly, for every s
+  if (sensitivity_infinite_) return 0;
+  if (config_.decoder.sensitivity == 0.0) return one();
+  // Eq. 5: c = difference / sum = difference * mantissa 2^-24 2^-e, uQ1.F (clamped to 1 against LUT error).
+  const fx::NormalisedReciprocal reciprocal =
+      fx::reciprocal_normalised(*reciprocal_, static_cast<std::uint64_t>(sum), F);
+  const fx::detail::int128 product = static_cast<fx::detail::int128>(difference) * reciprocal.mantissa_raw;
+  const int shift = reciprocal_->shape().output_frac_bits + reciprocal.exponent;
+  const fx::detail::int128 c128 = shift >= 0 ? (product + (static_cast<fx::detail::int128>(1) << shift >> 1)) >> shift
+                                             : product << -shift;
+  const Raw contrast = static_cast<Raw>(std::min<fx::detail::int128>(c128, one()));
+  // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
+  const Raw x = round_shift(sensitivity_raw_ * contrast,
+                            config_.sensitivity_frac_bits + F - config_.exp_input_frac_bits);
+  const Raw integer_part = x >> config_.exp_input_frac_bits;
+  if (integer_part >= 16) {
+    underflow = true;
+    return 0;
+  }
+  const Raw fraction = x & ((Raw{1} << config_.exp_input_frac_bits) - 1);
+  const Raw e_fraction = exp_fraction_->evaluate_raw(static_cast<std::uint32_t>(fraction));
+  return round_shift(exp_integer_rom_[static_cast<std::size_t>(integer_part)] * e_fraction, F);
+}
+
+WeightedSample FixedKernels::add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const {
+  WeightedSample out;
+  // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho is uQ1.F x sQ.R, rounded to F fraction bits (w x the tie
+  // correction, sQ2.F, likewise; it is 0 unless d_t had an exact tie here).
+  Raw sum = alpha + round_shift(weight * residual, config_.residual.frac_bits);
+  if (tie_correction != 0) sum += round_shift(weight * tie_correction, config_.linear_frac_bits);
+  out.alpha_prime = std::clamp(sum, Raw{0}, one());
+  out.clipped = out.alpha_prime != sum;
+  out.dropped = sum > out.alpha_prime ? sum - out.alpha_prime : out.alpha_prime - sum;
+  return out;
+}
+
+std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
+  // Binary search over the threshold ROM: o comparisons per sample.
+  const std::vector<Raw>& t = thresholds_[static_cast<std::size_t>(ch)];
+  int lo = 0;
+  int hi = max_output_code();
+  while (lo < hi) {
+    const int mid = (lo + hi + 1) / 2;
+    if (linear >= t[static_cast<std::size_t>(mid)]) lo = mid; else hi = mid - 1;
+  }
+  return static_cast<std::uint16_t>(lo);
+}
+
+Raw FixedKernels::drive_value(Raw linear, int ch) const {
+  if (linear >= one()) return Raw{1} << config_.drive_frac_bits;
+  return drive_luts_[static_cast<std::size_t>(ch)]->evaluate_raw(static_cast<std::uint32_t>(linear >> drive_lut_shift_));
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+
+FixedDecoderCore::FixedDecoderCore(FixedDecoderConfig config) : kernels_(config) {}
+
+EyeState& FixedDecoderCore::begin(const LinkFrame& frame, const char* who) {
+  const FixedDecoderConfig& config = kernels_.config();
+  const FrameMeta& meta = frame.meta;
+  const std::string what = std::string(who) + ": " + to_string(meta.parity) + " frame t=" + std::to_string(meta.index) +
+                           " eye=" + std::to_string(meta.eye) + ": ";
+  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
+  if (meta.bits != config.decoder.link.bits) throw std::invalid_argument(what + "link bits do not match the decoder");
+  if (meta.transfer != config.decoder.link.transfer) {
+    throw std::invalid_argument(what + "transfer does not match the decoder");
+  }
+  if (meta.full_width < 1 || meta.full_height < 1) throw std::invalid_argument(what + "full size must be at least 1x1");
+  if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
+    throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
+  }
+  const cv::Size full(meta.full_width, meta.full_height);
+  const Geometry& g = kernels_.geometry(full);
+  const cv::Size expected = meta.parity == Parity::Full ? full : g.reduced;
+  if (frame.codes.size() != expected || meta.width != expected.width || meta.height != expected.height) {
+    throw std::invalid_argument(what + "codes are " + std::to_string(frame.codes.cols) + "x" +
+                                std::to_string(frame.codes.rows) + " but must be " + std::to_string(expected.width) +
+                                "x" + std::to_string(expected.height));
+  }
+  double highest = 0.0;
+  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
+  if (highest > kernels_.max_code()) throw std::invalid_argument(what + "code exceeds the link bit depth");
+  EyeState& eye = eyes_[meta.eye];
+  if (eye.full_size != full) {
+    eye = EyeState();
+    eye.full_size = full;
+  }
+  return eye;
+}
+
+FrameOutput FixedDecoderCore::start_output(const LinkFrame& frame) const {
+  FrameOutput out;
+  const cv::Size full(frame.meta.full_width, frame.meta.full_height);
+  out.frame.meta = frame.meta;
+  out.frame.meta.width = full.width;
+  out.frame.meta.height = full.height;
+  out.frame.wanted_linear.create(full, CV_64FC3);
+  out.frame.drive.create(full, CV_64FC3);
+  out.frame.drive_codes.create(full, CV_16UC3);
+  out.frame.emitted_linear.create(full, CV_64FC3);
+  return out;
+}
+
+void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
+  if (!kernels_.lcd()) return;
+  out.lcd_held = eye.lcd_previous_drive.empty();
+  if (out.lcd_held) {
+    eye.lcd_previous_drive.create(eye.full_size, CV_16UC3);
+    eye.lcd_previous_linear.create(eye.full_size, CV_32SC3);
+  }
+}
+
+Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const {
+  const int k = 3 * x + ch;
+  out.frame.wanted_linear.ptr<double>(y)[k] = kernels_.linear_to_double(wanted);
+  if (!kernels_.lcd()) {
+    const std::uint16_t code = kernels_.drive_code(wanted, ch);
+    out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(kernels_.drive_value(wanted, ch));
+    out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = code;
+    out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted_of_code(code, ch);
+    return 0;
+  }
+  // LCD frame stores: v_{t-1} and x_{t-1} at this sample are read, then replaced by this frame's.
+  std::uint16_t& previous_code = eye.lcd_previous_drive.ptr<std::uint16_t>(y)[k];
+  std::int32_t& previous_linear = eye.lcd_previous_linear.ptr<std::int32_t>(y)[k];
+  const LcdSample s = kernels_.lcd_drive(wanted, previous_linear, previous_code, out.lcd_held);
+  out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(s.drive);
+  out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = s.code;
+  out.tally.counts.lcd_unreachable += s.unreachable ? 1 : 0;
+  const bool contributed = config().decoder.lcd_history == LcdHistory::Contributed;
+  out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.lcd_emitted(s.code, s.previous_code);
+  previous_code = s.code;
+  previous_linear = static_cast<std::int32_t>(contributed ? s.contributed : wanted);
+  return out.full ? s.shortfall : 0;
+}
+
+void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x,
+                                  const std::uint16_t* codes_row, const std::uint16_t* low0,
+                                  const std::uint16_t* low1, std::int32_t* residual_row) const {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+  FrameTally& t = out.tally;
+  for (int ch = 0; ch < 3; ++ch) {
+    const Raw low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
+    const Raw full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
+    const CompensatedSample s = kernels_.compensate(full_linear, low_linear);                                // Eq. 2
+    t.clipped += s.clipped ? 1 : 0;
+    t.counts.beta_clipped += s.clipped ? 1 : 0;
+    // LCD: an unreachable drive's shortfall joins rho (Sec. 4.4) before the residual store.
+    const Raw shortfall = emit(out, eye, y, x, ch, s.shown);
+    const StoredResidual stored = kernels_.store_residual(s.rho + shortfall);
+    residual_row[3 * x + ch] = static_cast<std::int32_t>(stored.value);
+    t.counts.residual_saturated += stored.saturated ? 1 : 0;
+    t.counts.residual_rounded += stored.rounded ? 1 : 0;
+    const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
+    t.residual_abs_sum += magnitude;
+    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
+  }
+}
+
+void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
+                                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
+                                     const std::int32_t* residual_row) const {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+  Raw alpha[3];
+  for (int ch = 0; ch < 3; ++ch) {
+    alpha[ch] = kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
+  }
+  if (residual_row == nullptr) {
+    // No full frame just before: alpha alone (U of codes stays within [0, 1]; the clamp only guards).
+    for (int ch = 0; ch < 3; ++ch) emit(out, eye, y, x, ch, std::clamp(alpha[ch], Raw{0}, kernels_.one()));
+    return;
+  }
+  // L_{t-1} for the motion test, exact ties resolved towards the received codes; and the tie correction: the full
+  // frame compensated against the unresolved L_used, so L_used - L_resolved joins rho (Eq. 3 then holds exactly for
+  // static content, as in the reference, whose d_t is the encoder's own rounding).
+  Raw previous[3];
+  Raw tie_correction[3] = {0, 0, 0};
+  for (int ch = 0; ch < 3; ++ch) {
+    previous[ch] = kernels_.linear_of_upsampled(kernels_.upsample_previous(prev0, prev1, in0, in1, col, row.upper, ch));
+    if (kernels_.has_tie(prev0, prev1, col, ch)) {
+      tie_correction[ch] = kernels_.linear_of_upsampled(kernels_.upsample_stored(prev0, prev1, col, row.upper, ch)) -
+                           previous[ch];
+    }
+  }
+  FrameTally& t = out.tally;
+  bool underflow = false;
+  const Raw weight = kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);  // Eqs. 5-6
+  t.weight_sum += weight;
+  t.counts.weight_underflow += underflow ? 1 : 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    const Raw residual = residual_row[3 * x + ch];
+    const WeightedSample s = kernels_.add_weighted_residual(alpha[ch], weight, residual, tie_correction[ch]);  // Eq. 4
+    t.clipped += s.clipped ? 1 : 0;
+    t.counts.alpha_clipped += s.clipped ? 1 : 0;
+    t.dropped_sum += s.dropped;
+    const Raw magnitude = residual < 0 ? -residual : residual;
+    t.residual_abs_sum += magnitude;
+    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
+    emit(out, eye, y, x, ch, s.alpha_prime);
+  }
+}
+
+DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, bool full, bool residual_applied) {
+  const FrameTally& t = out.tally;
+  const double samples = 3.0 * static_cast<double>(out.frame.wanted_linear.total());
+  FrameStats& stats = out.frame.stats;
+  stats.clipped_fraction = static_cast<double>(t.clipped) / samples;
+  if (full || residual_applied) {
+    stats.residual_mean_abs = kernels_.residual_to_double(t.residual_abs_sum) / samples;
+    stats.residual_max_abs = kernels_.residual_to_double(t.residual_abs_max);
+  }
+  if (residual_applied) {
+    stats.residual_applied = true;
+    stats.dropped_sum = kernels_.linear_to_double(t.dropped_sum);
+    stats.mean_motion_weight = kernels_.linear_to_double(t.weight_sum) / (samples / 3.0);
+  }
+  stats.lcd_unreachable_fraction = static_cast<double>(t.counts.lcd_unreachable) / samples;
+  last_counts_ = t.counts;
+  return std::move(out.frame);
+}
+
+}  // namespace fixed_detail
+}  // namespace trm

@@ -1,0 +1,259 @@
+// The per-pixel arithmetic of the fixed-point decoder, one function per stage, shared by the frame-at-a-time and
+// the streaming schedules (so they can differ only in scheduling), plus the state both keep per eye.
+// Raw values are integers; each function states its Q formats. F = linear_frac_bits throughout.
+#pragma once
+
+#include "trm/fixed_decoder.hpp"
+#include "trm/lut.hpp"
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace trm::fixed_detail {
+
+using Raw = std::int64_t;
+
+// Round half up (SC_RND) of v / 2^shift; C++20 >> on negative values is arithmetic, so this holds for any sign.
+inline Raw round_shift(Raw v, int shift) { return shift <= 0 ? v * (Raw{1} << -shift) : (v + (Raw{1} << (shift - 1))) >> shift; }
+
+// The d_t frame store keeps one flag bit beside each code (codes are at most 10 bits): set where D(E_t) fell exactly
+// half-way between d and d - 1. The encoder's double D rounds such ties by floating-point noise, so the reduced
+// frame that follows may carry either code; the motion test then takes the one received (resolve_tie), keeping
+// static content static (DESIGN §4: "c = 0 when nothing moved"), and the difference between the low-pass the full
+// frame used and the resolved one joins the residual (so alpha + beta = 2 I still holds, Eq. 3).
+inline constexpr std::uint16_t kTieFlag = 0x8000;
+inline std::uint16_t code_of(std::uint16_t stored) { return static_cast<std::uint16_t>(stored & ~kTieFlag); }
+inline Raw resolve_tie(std::uint16_t stored, std::uint16_t received) {
+  const Raw code = code_of(stored);
+  return (stored & kTieFlag) != 0 && received + 1 == code ? code - 1 : code;
+}
+
+// Round half to even (SC_RND_CONV) of v / 2^shift, shift >= 1. Used where two values that sum to an integer must
+// still do so after rounding (complementary rows of a Nyquist pattern in the D line buffer).
+inline Raw round_convergent_shift(Raw v, int shift) {
+  const Raw floor = v >> shift;
+  const Raw rest = v - (floor << shift);
+  const Raw half = Raw{1} << (shift - 1);
+  return floor + ((rest > half || (rest == half && (floor & 1) != 0)) ? 1 : 0);
+}
+
+// D taps of one reduced sample along one axis: indices clamped (replicate), weights uQ0.T summing to 2^T.
+struct PolyphaseTaps {
+  std::vector<int> index;
+  std::vector<Raw> weight;
+  int first() const { return index.front(); }  // indices are non-decreasing
+  int last() const { return index.back(); }
+};
+
+// U along one axis for one full-resolution sample: weight of i1 in uQ0.W; i0 gets 2^W - upper.
+struct BilinearWeights {
+  int i0 = 0;
+  int i1 = 0;
+  Raw upper = 0;
+};
+
+// Everything that depends on the view size: taps per axis.
+struct Geometry {
+  cv::Size full;
+  cv::Size reduced;
+  std::vector<PolyphaseTaps> gauss_cols;  // reduced.width entries
+  std::vector<PolyphaseTaps> gauss_rows;  // reduced.height entries
+  std::vector<BilinearWeights> bilinear_cols;  // full.width entries
+  std::vector<BilinearWeights> bilinear_rows;  // full.height entries
+};
+
+// Result of Eq. 2 and the split for one channel sample of a full frame.
+struct CompensatedSample {
+  Raw shown = 0;  // clamp(beta, 0, 1), uQ1.F
+  Raw rho = 0;    // beta - shown, sQ2.F (before the residual store)
+  bool clipped = false;
+};
+
+// rho (plus any LCD shortfall) as the residual frame store holds it.
+struct StoredResidual {
+  Raw value = 0;  // residual store format
+  bool saturated = false;
+  bool rounded = false;
+};
+
+// LCD drive of one channel sample (Eq. 7 inverse).
+struct LcdSample {
+  std::uint16_t code = 0;
+  std::uint16_t previous_code = 0;  // v_{t-1} the merge was solved against (the held code on the first frame)
+  Raw drive = 0;        // v, uQ1.drive_frac_bits (reports)
+  Raw shortfall = 0;    // x_t - x_t_eff where unreachable, sQ.F
+  Raw contributed = 0;  // x_t, or x_t_eff where unreachable, sQ.F
+  bool unreachable = false;
+};
+
+struct WeightedSample {
+  Raw alpha_prime = 0;  // clamp(alpha + w rho, 0, 1), uQ1.F
+  Raw dropped = 0;      // |alpha + w rho - alpha'|, uQ2.F
+  bool clipped = false;
+};
+
+// Order-independent accumulators of one frame (integers, so both schedules report identical statistics).
+struct FrameTally {
+  FixedStageCounts counts;
+  std::uint64_t clipped = 0;     // samples for FrameStats::clipped_fraction
+  Raw dropped_sum = 0;           // uQ.F
+  Raw weight_sum = 0;            // uQ.F over pixels
+  Raw residual_abs_sum = 0;      // in residual format LSBs
+  Raw residual_abs_max = 0;
+};
+
+class FixedKernels {
+ public:
+  explicit FixedKernels(const FixedDecoderConfig& config);
+
+  const FixedDecoderConfig& config() const { return config_; }
+  int linear_frac_bits() const { return config_.linear_frac_bits; }
+  Raw one() const { return Raw{1} << config_.linear_frac_bits; }
+  int max_code() const { return (1 << config_.decoder.link.bits) - 1; }
+  int max_output_code() const { return (1 << config_.decoder.output_bits) - 1; }
+
+  // The taps for a view size (built once per size and cached).
+  const Geometry& geometry(cv::Size full);
+
+  // I = lin(E): direct ROM indexed by the link code; uQ1.F.
+  Raw linear_of_code(std::uint16_t code) const { return code_rom_[code]; }
+
+  // D, horizontal half: sum_i w_i E_i over one row of codes (channel ch of interleaved RGB), uQb.L (L = line bits).
+  Raw gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const;
+  // D, vertical half, and Q_b: d = round(sum_j w_j h_j) where rows[j] is the line buffer row of tap j; a link code,
+  // with kTieFlag set when the sum was exactly half-way (strip it with code_of for arithmetic).
+  std::uint16_t gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const;
+
+  // U: bilinear blend of reduced codes rows row0 (i0) and row1 (i1) at full column x, channel ch; codes uQb.U.
+  Raw upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col, Raw row_upper,
+               int ch) const;
+  // U of the stored d_{t-1} for the motion test, each sample's exact tie resolved towards the received code.
+  Raw upsample_previous(const std::uint16_t* stored0, const std::uint16_t* stored1, const std::uint16_t* received0,
+                        const std::uint16_t* received1, const BilinearWeights& col, Raw row_upper, int ch) const;
+  // U of the stored d_t codes as the full frame used them (tie flags stripped), and whether any of the four had a tie.
+  Raw upsample_stored(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col,
+                      Raw row_upper, int ch) const;
+  bool has_tie(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col, int ch) const;
+  // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd).
+  Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
+  // lin() of U's encoded output through the interpolated EOTF LUT; uQ1.F.
+  Raw linear_of_upsampled(Raw upsampled) const;
+
+  // Eq. 2: beta = 2 I - L (sQ3.F), shown = clamp(beta, 0, 1), rho = beta - shown.
+  CompensatedSample compensate(Raw full_linear, Raw low_linear) const;
+  // rho (sQ.F) into the residual store format (its rounding and overflow modes).
+  StoredResidual store_residual(Raw rho) const;
+
+  bool lcd() const { return lcd_; }
+  // LCD (Eq. 7 inverse): the drive code whose merge with v_{t-1} = previous_code reaches m = ((x_t + x_{t-1})/2)^(1/g).
+  // held: the eye's first frame, x_{t-1} = x_t and the pixel held (M(v, v)); returns the held code.
+  LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const;
+  double lcd_emitted(std::uint16_t code, std::uint16_t previous_code) const;
+
+  // Rec. 709 luma of linear RGB (uQ1.F each); uQ1.F.
+  Raw luma(const Raw* rgb) const;
+  // Eqs. 5-6: c = |Yp - Ya| / (Yp + Ya) (0 where the sum is 0), w = exp(-s c); uQ1.F. Sets underflow when s c >= 16.
+  Raw motion_weight(Raw luma_previous, Raw luma_alpha, bool& underflow) const;
+  // Eq. 4: alpha' = clamp(alpha + w (rho + tie_correction), 0, 1); tie_correction = L_used - L_resolved (uQ.F).
+  WeightedSample add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const;
+
+  // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
+  std::uint16_t drive_code(Raw linear, int ch) const;
+  // Drive value v = x^(1/gamma) for reports, uQ1.drive_frac_bits.
+  Raw drive_value(Raw linear, int ch) const;
+  double emitted_of_code(std::uint16_t code, int ch) const { return emission_[ch][code]; }
+
+  // Exact conversions (the raw values have at most 53 significant bits; the scales are powers of two).
+  double linear_to_double(Raw v) const { return static_cast<double>(v) * linear_lsb_; }
+  double drive_to_double(Raw v) const { return static_cast<double>(v) * drive_lsb_; }
+  double residual_to_double(Raw v) const { return static_cast<double>(v) * residual_lsb_; }
+
+ private:
+  FixedDecoderConfig config_;
+  std::vector<Raw> code_rom_;
+  std::unique_ptr<fx::InterpolatedLut> eotf_;
+  std::unique_ptr<fx::InterpolatedLut> reciprocal_;
+  std::unique_ptr<fx::InterpolatedLut> exp_fraction_;
+  std::vector<Raw> exp_integer_rom_;  // exp(-i), i = 0..15, uQ1.F
+  std::array<Raw, 3> luma_weights_{};
+  Raw sensitivity_raw_ = 0;
+  bool sensitivity_infinite_ = false;
+  std::array<std::vector<Raw>, 3> thresholds_;  // T_k, k = 0..2^o - 1 (T_0 = 0)
+  std::array<std::unique_ptr<fx::InterpolatedLut>, 3> drive_luts_;
+  int drive_lut_shift_ = 0;  // linear LSBs dropped to address the drive LUT (24 address bits at most)
+  std::array<std::vector<double>, 3> emission_;
+  double linear_lsb_ = 0.0;
+  double drive_lsb_ = 0.0;
+  double residual_lsb_ = 0.0;
+  std::map<std::pair<int, int>, Geometry> geometries_;
+  // LCD: merge coefficients in sQ.kLcdCoefficientBits, x^(1/gamma) LUT for m, and M(0, vp)^gamma, M(1, vp)^gamma
+  // ROMs (uQ/sQ.F) for the shortfall at the two clamped drives.
+  bool lcd_ = false;
+  std::array<Raw, 4> lcd_coefficients_{};       // p1..p4
+  std::array<Raw, 4> lcd_held_coefficients_{};  // M(v, v): 2 p1 + p2, 0, 2 p3, p4
+  std::unique_ptr<fx::InterpolatedLut> lcd_target_lut_;
+  std::array<std::vector<Raw>, 2> lcd_end_luminance_;
+  // The merge scaled to an integer: (2 Mx)^2 2^P M(t / (2 Mx), j / Mx).
+  Raw scaled_merge(const std::array<Raw, 4>& p, Raw t, Raw j) const;
+  Raw lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const;
+};
+
+// What persists between frames of one eye (DESIGN §5 frame stores).
+struct EyeState {
+  cv::Size full_size;
+  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} codes, full size, CV_16UC3 (empty: no history yet)
+  cv::Mat lcd_previous_linear;  // LCD: x_{t-1}, full size, CV_32SC3 sQ.F
+  bool have_residual = false;
+  std::int64_t residual_index = 0;
+  cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
+  cv::Mat previous_low;   // d_t codes with kTieFlag, reduced size, CV_16UC3
+};
+
+// Output frame under construction and the per-pixel emission shared by both schedules.
+struct FrameOutput {
+  DecodedFrame frame;
+  FrameTally tally;
+  bool lcd_held = false;  // LCD: the eye's first frame (no v_{t-1} yet)
+  bool full = false;
+};
+
+// The state and plumbing shared by both schedules: configuration, ROMs, eye states, input checks and output.
+class FixedDecoderCore {
+ public:
+  explicit FixedDecoderCore(FixedDecoderConfig config);
+
+  FixedKernels& kernels() { return kernels_; }
+  const FixedDecoderConfig& config() const { return kernels_.config(); }
+  const FixedStageCounts& last_counts() const { return last_counts_; }
+
+  // Checks the frame and returns the eye state (reset on a change of view size).
+  EyeState& begin(const LinkFrame& frame, const char* who);
+  // Allocates the output matrices at full size.
+  FrameOutput start_output(const LinkFrame& frame) const;
+  // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
+  Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
+  // Prepares the LCD frame stores of the eye for this frame (first frame: held history).
+  void begin_lcd(FrameOutput& out, EyeState& eye) const;
+  // One full-frame pixel, all channels (Eq. 2): U of the d_t rows i0/i1 of output row y, L, I from the codes row,
+  // beta, shown (emitted), rho into residual_row.
+  void full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* codes_row,
+                  const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row) const;
+  // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
+  // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
+  void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
+                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
+                     const std::int32_t* residual_row) const;
+  // Fills FrameStats from the tally and remembers the counts.
+  DecodedFrame finish(FrameOutput&& out, bool full, bool residual_applied);
+
+ private:
+  FixedKernels kernels_;
+  std::map<int, EyeState> eyes_;
+  FixedStageCounts last_counts_;
+};
+
+}  // namespace trm::fixed_detail

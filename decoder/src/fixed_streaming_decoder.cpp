@@ -1,0 +1,237 @@
+// Streaming schedule of the fixed-point decoder (DESIGN §5): raster order, one input line at a time, through
+// explicit circular line buffers and frame stores. The per-pixel arithmetic is the shared one (fixed_kernels.hpp),
+// so this file only decides WHEN each line is computed and WHERE its inputs are held.
+//
+// Full frame, after each input line E_t(y_in):
+//   1. the line enters the delay buffer (full width, link codes; I_t needs it when output row y_in is produced) and
+//      its horizontal D pass enters the vertical Gaussian buffer (reduced width, uQb.L, at most 2R + 1 lines);
+//   2. repeatedly: every output row whose U rows i0, i1 of d_t exist is produced; then the next reduced row of d_t
+//      is produced if all its vertical taps have arrived (it enters the 2-line U buffer and the d_t frame store).
+// Reduced frame, after each input line i(k): it enters the 2-line U buffer and every output row with i1 <= k is
+// produced. The residual and d_{t-1} frame stores are read row by row.
+#include "fixed_kernels.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace trm {
+
+using fixed_detail::FixedDecoderCore;
+using fixed_detail::Geometry;
+using fixed_detail::Raw;
+
+namespace {
+
+// `depth` circular lines of `samples` values; input line n lives in slot n mod depth. Reading a line that was
+// overwritten (or never written) is a scheduling bug and throws.
+template <typename T>
+class LineRing {
+ public:
+  LineRing(std::string name, int depth, int samples)
+      : name_(std::move(name)), samples_(samples), data_(static_cast<std::size_t>(depth) * samples), tags_(static_cast<std::size_t>(depth), -1) {}
+
+  T* write(int line) {
+    const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
+    tags_[slot] = line;
+    return data_.data() + slot * static_cast<std::size_t>(samples_);
+  }
+  const T* read(int line) const {
+    const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
+    if (tags_[slot] != line) {
+      throw std::logic_error("line buffer '" + name_ + "': line " + std::to_string(line) + " is not held");
+    }
+    return data_.data() + slot * static_cast<std::size_t>(samples_);
+  }
+
+ private:
+  std::string name_;
+  int samples_;
+  std::vector<T> data_;
+  std::vector<int> tags_;
+};
+
+// The full-frame schedule as callbacks: on_input(y_in), on_reduced(k, y_in), on_output(y, y_in, reduced_ready).
+template <typename OnInput, typename OnReduced, typename OnOutput>
+void full_frame_schedule(const Geometry& g, OnInput on_input, OnReduced on_reduced, OnOutput on_output) {
+  int next_reduced = 0;
+  int next_output = 0;
+  for (int y_in = 0; y_in < g.full.height; ++y_in) {
+    on_input(y_in);
+    for (;;) {
+      while (next_output < g.full.height && next_output <= y_in &&
+             g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 < next_reduced) {
+        on_output(next_output++, y_in, next_reduced);
+      }
+      if (next_reduced < g.reduced.height && g.gauss_rows[static_cast<std::size_t>(next_reduced)].last() <= y_in) {
+        on_reduced(next_reduced++, y_in);
+      } else {
+        break;
+      }
+    }
+  }
+}
+
+// The reduced-frame schedule: on_input(k), on_output(y, k).
+template <typename OnInput, typename OnOutput>
+void reduced_frame_schedule(const Geometry& g, OnInput on_input, OnOutput on_output) {
+  int next_output = 0;
+  for (int k = 0; k < g.reduced.height; ++k) {
+    on_input(k);
+    while (next_output < g.full.height && g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 <= k) {
+      on_output(next_output++, k);
+    }
+  }
+}
+
+// Line counts the schedules need, from a dry run over the indices.
+struct StreamPlan {
+  int gauss_lines = 0;     // vertical Gaussian buffer
+  int delay_lines = 0;     // full-width delay of E_t for I_t
+  int low_lines = 0;       // U buffer of d_t (full frames)
+  int reduced_lines = 0;   // U buffer of i (reduced frames)
+  int full_latency = 0;
+  int reduced_latency = 0;
+};
+
+StreamPlan plan_for(const Geometry& g) {
+  StreamPlan p;
+  full_frame_schedule(
+      g, [](int) {},
+      [&](int k, int y_in) {
+        p.gauss_lines = std::max(p.gauss_lines, y_in - g.gauss_rows[static_cast<std::size_t>(k)].first() + 1);
+      },
+      [&](int y, int y_in, int ready) {
+        p.delay_lines = std::max(p.delay_lines, y_in - y + 1);
+        p.full_latency = std::max(p.full_latency, y_in - y);
+        p.low_lines = std::max(p.low_lines, ready - g.bilinear_rows[static_cast<std::size_t>(y)].i0);
+      });
+  reduced_frame_schedule(
+      g, [](int) {},
+      [&](int y, int k) {
+        const int i0 = g.bilinear_rows[static_cast<std::size_t>(y)].i0;
+        p.reduced_lines = std::max(p.reduced_lines, k - i0 + 1);
+        p.reduced_latency = std::max(p.reduced_latency, k - i0);
+      });
+  return p;
+}
+
+}  // namespace
+
+FixedStreamingDecoder::FixedStreamingDecoder(FixedDecoderConfig config)
+    : core_(std::make_unique<FixedDecoderCore>(std::move(config))) {}
+FixedStreamingDecoder::~FixedStreamingDecoder() = default;
+FixedStreamingDecoder::FixedStreamingDecoder(FixedStreamingDecoder&&) noexcept = default;
+FixedStreamingDecoder& FixedStreamingDecoder::operator=(FixedStreamingDecoder&&) noexcept = default;
+const FixedDecoderConfig& FixedStreamingDecoder::config() const { return core_->config(); }
+const FixedStageCounts& FixedStreamingDecoder::last_counts() const { return core_->last_counts(); }
+
+FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
+  const Geometry& g = core_->kernels().geometry(full);
+  const StreamPlan p = plan_for(g);
+  const FixedDecoderConfig& c = core_->config();
+  const int b = c.decoder.link.bits;
+  FixedStreamingReport r;
+  r.full_latency_lines = p.full_latency;
+  r.reduced_latency_lines = p.reduced_latency;
+  r.buffers = {
+      {"line: vertical Gaussian (horizontal D results, uQb.L)", p.gauss_lines, 3 * g.reduced.width, b + c.gaussian_line_frac_bits},
+      {"line: E_t delay for I_t (link codes)", p.delay_lines, 3 * g.full.width, b},
+      {"line: U of d_t (full frames, codes)", p.low_lines, 3 * g.reduced.width, b},
+      {"line: U of i (reduced frames, codes)", p.reduced_lines, 3 * g.reduced.width, b},
+      {"frame: residual rho (" + c.residual.to_string() + ")", g.full.height, 3 * g.full.width, c.residual.width()},
+      {"frame: d_t for the motion test (codes + exact-tie flag)", g.reduced.height, 3 * g.reduced.width, b + 1},
+  };
+  if (c.decoder.panel.kind == PanelKind::Lcd) {
+    r.buffers.push_back({"frame: LCD v_{t-1} (drive codes)", g.full.height, 3 * g.full.width, c.decoder.output_bits});
+    r.buffers.push_back({"frame: LCD x_{t-1} (sQ3." + std::to_string(c.linear_frac_bits) + ")", g.full.height,
+                         3 * g.full.width, 3 + c.linear_frac_bits});
+  }
+  return r;
+}
+
+DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame) {
+  fixed_detail::EyeState& eye = core_->begin(frame, "FixedStreamingDecoder");
+  fixed_detail::FixedKernels& kernels = core_->kernels();
+  const Geometry& g = kernels.geometry(eye.full_size);
+  const StreamPlan plan = plan_for(g);
+  fixed_detail::FrameOutput out = core_->start_output(frame);
+  out.full = frame.meta.parity == Parity::Full;
+  core_->begin_lcd(out, eye);
+  const int full_samples = 3 * g.full.width;
+  const int reduced_samples = 3 * g.reduced.width;
+
+  if (frame.meta.parity == Parity::Full) {
+    LineRing<std::uint16_t> delay("E_t delay", plan.delay_lines, full_samples);
+    LineRing<Raw> gauss("vertical Gaussian", plan.gauss_lines, reduced_samples);
+    LineRing<std::uint16_t> low_lines("U of d_t", plan.low_lines, reduced_samples);
+    cv::Mat residual_store(g.full, CV_32SC3);   // frame store rho
+    cv::Mat low_store(g.reduced, CV_16UC3);     // frame store d_t
+    std::vector<const Raw*> tap_rows;
+
+    full_frame_schedule(
+        g,
+        [&](int y_in) {
+          const std::uint16_t* in = frame.codes.ptr<std::uint16_t>(y_in);
+          std::copy(in, in + full_samples, delay.write(y_in));
+          Raw* h = gauss.write(y_in);
+          for (int k = 0; k < g.reduced.width; ++k) {
+            for (int ch = 0; ch < 3; ++ch) {
+              h[3 * k + ch] = kernels.gaussian_horizontal(in, g.gauss_cols[static_cast<std::size_t>(k)], ch);
+            }
+          }
+        },
+        [&](int k, int) {
+          const fixed_detail::PolyphaseTaps& taps = g.gauss_rows[static_cast<std::size_t>(k)];
+          tap_rows.clear();
+          for (int index : taps.index) tap_rows.push_back(gauss.read(index));
+          std::uint16_t* d = low_lines.write(k);
+          std::uint16_t* stored = low_store.ptr<std::uint16_t>(k);
+          for (int i = 0; i < reduced_samples; ++i) {
+            stored[i] = kernels.gaussian_vertical(tap_rows.data(), taps, i);
+            d[i] = fixed_detail::code_of(stored[i]);
+          }
+        },
+        [&](int y, int, int) {
+          const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+          const std::uint16_t* codes_row = delay.read(y);
+          const std::uint16_t* low0 = low_lines.read(row.i0);
+          const std::uint16_t* low1 = low_lines.read(row.i1);
+          std::int32_t* residual_row = residual_store.ptr<std::int32_t>(y);
+          for (int x = 0; x < g.full.width; ++x) core_->full_pixel(out, eye, g, y, x, codes_row, low0, low1, residual_row);
+        });
+    eye.have_residual = true;
+    eye.residual_index = frame.meta.index;
+    eye.residual = residual_store;
+    eye.previous_low = low_store;
+    return core_->finish(std::move(out), true, false);
+  }
+
+  const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
+  LineRing<std::uint16_t> in_lines("U of i", plan.reduced_lines, reduced_samples);
+  reduced_frame_schedule(
+      g,
+      [&](int k) {
+        const std::uint16_t* in = frame.codes.ptr<std::uint16_t>(k);
+        std::copy(in, in + reduced_samples, in_lines.write(k));
+      },
+      [&](int y, int) {
+        const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+        const std::uint16_t* in0 = in_lines.read(row.i0);
+        const std::uint16_t* in1 = in_lines.read(row.i1);
+        const std::uint16_t* prev0 = residual_applies ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
+        const std::uint16_t* prev1 = residual_applies ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
+        const std::int32_t* residual_row = residual_applies ? eye.residual.ptr<std::int32_t>(y) : nullptr;
+        for (int x = 0; x < g.full.width; ++x) {
+          core_->reduced_pixel(out, eye, g, y, x, in0, in1, prev0, prev1, residual_row);
+        }
+      });
+  eye.have_residual = false;
+  eye.residual.release();
+  eye.previous_low.release();
+  return core_->finish(std::move(out), false, residual_applies);
+}
+
+}  // namespace trm

@@ -1,0 +1,99 @@
+// Pacing, dropping and the summary, with an in-memory transport (no device involved).
+#include "rig/feeder.hpp"
+#include "rig_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+namespace trm::rig::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+class MemoryTransport final : public RigTransport {
+ public:
+  explicit MemoryTransport(std::chrono::milliseconds delay_per_frame_end = 0ms) : delay_(delay_per_frame_end) {}
+  std::string description() const override { return "memory"; }
+  std::size_t max_packet_size() const override { return 256; }
+  void send(std::span<const std::uint8_t> packet) override {
+    bytes.insert(bytes.end(), packet.begin(), packet.end());
+    if (packet[0] == static_cast<std::uint8_t>(PacketType::FrameEnd)) std::this_thread::sleep_for(delay_);
+  }
+  bool can_receive() const override { return false; }
+  std::optional<std::vector<std::uint8_t>> receive(std::chrono::milliseconds) override { return std::nullopt; }
+  TransportRate nominal_rate() const override { return {64000.0, "test"}; }
+  std::vector<std::uint8_t> bytes;
+
+ private:
+  std::chrono::milliseconds delay_;
+};
+
+TEST(RigFeeder, PacesFramesAtTheRequestedRate) {
+  MemoryTransport transport;
+  FeedOptions options;
+  options.fps = 100.0;
+  const auto started = std::chrono::steady_clock::now();
+  std::vector<RigFrame> frames;
+  for (int i = 0; i < 6; ++i) frames.push_back(synthetic_frame(i, 0, 4, 4, 8));
+  const FeedStats stats = feed_all(transport, frames, options);
+  const auto took = std::chrono::steady_clock::now() - started;
+  EXPECT_GE(took, 50ms);  // slots 0..5 open at 0, 10, ..., 50 ms
+  EXPECT_LT(took, 1000ms);
+  EXPECT_EQ(stats.frames_sent, 6);
+  EXPECT_EQ(stats.frames_dropped, 0);
+  expect_same_frames(receive_stream(transport.bytes), frames);
+}
+
+TEST(RigFeeder, DropsFramesWhoseSlotHasPassed) {
+  MemoryTransport transport(25ms);  // each frame takes 2.5 slots at 100 Hz
+  FeedOptions options;
+  options.fps = 100.0;
+  std::vector<RigFrame> frames;
+  for (int i = 0; i < 8; ++i) frames.push_back(synthetic_frame(i, 0, 4, 4, 8));
+  const FeedStats stats = feed_all(transport, frames, options);
+  EXPECT_EQ(stats.frames_sent + stats.frames_dropped, 8);
+  EXPECT_GE(stats.frames_dropped, 3);
+  EXPECT_EQ(static_cast<std::int64_t>(receive_stream(transport.bytes).size()), stats.frames_sent);
+
+  MemoryTransport unhurried(25ms);
+  options.drop_late = false;
+  EXPECT_EQ(feed_all(unhurried, frames, options).frames_dropped, 0);
+}
+
+TEST(RigFeeder, SummaryAndProgressLine) {
+  MemoryTransport transport;
+  FeedOptions options;
+  int progress_calls = 0;
+  options.on_progress = [&](const FeedStats&) { ++progress_calls; };
+  const FeedStats stats = feed_all(transport, {synthetic_frame(7, 0, 30, 30, 10)}, options);
+  EXPECT_GE(progress_calls, 1);
+  const auto j = stats.to_json();
+  EXPECT_EQ(j["frames_sent"], 1);
+  EXPECT_EQ(j["last_frame_sent"], 7);
+  EXPECT_EQ(j["wire_bytes_sent"], transport.bytes.size());
+  EXPECT_EQ(j["payload_bytes_sent"], 30u * 30u * 3u * 2u);
+  EXPECT_FALSE(j.contains("interrupted"));
+  EXPECT_NE(stats.progress_line().find("sent 1 frames"), std::string::npos);
+}
+
+TEST(RigFeeder, TimePerFrameFollowsTheTransportRate) {
+  MemoryTransport transport;  // 64 kB/s, 256-byte packets
+  RigFrame headset;
+  headset.width = 1080;
+  headset.height = 1200;
+  headset.bits = 8;
+  // 3,888,000 payload bytes in 248-byte chunks: 15,678 chunks, 8 bytes of header each.
+  const double seconds = RigFeeder::seconds_per_frame(transport, headset);
+  EXPECT_NEAR(seconds, (3888000.0 + 15678 * 8 + 64 + 24) / 64000.0, 1e-6);
+}
+
+TEST(RigFeeder, FlowControlNeedsATransportThatCanAnswer) {
+  MemoryTransport transport;
+  FeedOptions options;
+  options.flow_control = true;
+  EXPECT_THROW(RigFeeder(transport, options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace trm::rig::testing
