@@ -142,7 +142,7 @@ TEST(Concealment, LcdEmissionRecoversWithinAFewFramesAfterTheLastFault) {
       std::cout << "LCD recovery (moving random content): after " << kFrames - 1 - kLastFault << " frames "
                 << 100.0 * beyond_step_fraction << " % of samples emit more than one code step off the fault-free "
                 << "run (" << 100.0 * unreachable_fraction << " % of targets unreachable in that frame)\n";
-      EXPECT_LT(beyond_step_fraction, 0.25);
+      EXPECT_LT(beyond_step_fraction, 0.02);
       continue;
     }
     ASSERT_GE(recovered_at, 0) << content << ": LCD emission never recovered";
