@@ -201,3 +201,23 @@ TEST(Cli, LowRefreshWarnsButRuns) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("flicker"), std::string::npos);
 }
+
+TEST(Cli, LosslessCurveFallsWithTheReduction) {
+  TempDir tmp;
+  const Result r = run_trm("lossless --scene panorama --size 96x80 --frames 4 --reduction 1 0.5 0.25 --out " +
+                           tmp.str("ll"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(tmp.path() / "ll" / "report.json");
+  const auto report = nlohmann::json::parse(in);
+  const auto& row = report["results"][0];
+  const double full = row["full_rate_bpp"].get<double>();
+  const double r1 = row["trm_bpp"]["1.000000"].get<double>();
+  const double r05 = row["trm_bpp"]["0.500000"].get<double>();
+  const double r025 = row["trm_bpp"]["0.250000"].get<double>();
+  // Natural texture: the reduced frames code to fewer bits the smaller they are, and below full rate.
+  EXPECT_GT(full, 0.0);
+  EXPECT_LT(r05, r1);
+  EXPECT_LT(r025, r05);
+  EXPECT_LT(r05, full);
+  EXPECT_NE(run_trm("lossless --scene panorama --reduction 0 --size 8x8").exit_code, 0);
+}

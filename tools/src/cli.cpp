@@ -18,6 +18,7 @@ int run_main(int argc, char** argv) {
   Action action;
   register_run(app, action);
   register_decode(app, action);
+  register_lossless(app, action);
   register_feed(app, action);
 
   try {

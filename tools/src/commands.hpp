@@ -7,6 +7,7 @@ namespace trm::cli {
 
 void register_run(CLI::App& app, Action& action);
 void register_decode(CLI::App& app, Action& action);
+void register_lossless(CLI::App& app, Action& action);
 void register_feed(CLI::App& app, Action& action);
 
 }  // namespace trm::cli
