@@ -444,8 +444,12 @@ LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t
   const Raw x_previous = held ? wanted : previous_wanted;
   out.previous_code = static_cast<std::uint16_t>(j);
   out.contributed = wanted;
-  const bool below = target_scaled < scaled_merge(lcd_coefficients_, 0, j);
-  const bool above = target_scaled > scaled_merge(lcd_coefficients_, two_top, j);
+  // Reachability is decided in linear light, on the sum x_t + x_{t-1} against 2 M(0|1, v_{t-1})^gamma from the same
+  // ROMs the shortfall uses. The exact ends of the range are met exactly: white after white (the ROM holds 1.0),
+  // black after black, and with LcdHistory::Contributed the next target, which is built from the ROM value itself.
+  // (In m, the 1/gamma power and the quantised coefficients would blur these ends by many LSB near black.)
+  const bool below = sum < 2 * lcd_end_luminance_[0][static_cast<std::size_t>(j)];
+  const bool above = sum > 2 * lcd_end_luminance_[1][static_cast<std::size_t>(j)];
   if (below || above) {
     // No root in [0, 1]: v clamps to the nearer end; frame t contributes x_eff = 2 M(v, v_prev)^gamma - x_{t-1}.
     out.unreachable = true;
@@ -584,8 +588,9 @@ void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
   if (!kernels_.lcd()) return;
   out.lcd_held = eye.lcd_previous_drive.empty();
   if (out.lcd_held) {
-    eye.lcd_previous_drive.create(eye.full_size, CV_16UC3);
-    eye.lcd_previous_linear.create(eye.full_size, CV_32SC3);
+    // Not read on the held frame (lcd_drive takes x_{t-1} = x_t and the held code); zeroed to stay defined.
+    eye.lcd_previous_drive = cv::Mat::zeros(eye.full_size, CV_16UC3);
+    eye.lcd_previous_linear = cv::Mat::zeros(eye.full_size, CV_32SC3);
   }
 }
 

@@ -146,6 +146,7 @@ struct Agreement {
   std::uint64_t identical = 0;
   int max_lsb = 0;
   double max_merged_codes = 0.0;  // LCD: max |M_fixed - M_reference| (2^o - 1), the merge the eye sees
+  double max_unreachable_difference = 0.0;  // LCD: max per-frame difference of the unreachable fractions
   double identical_fraction() const { return static_cast<double>(identical) / static_cast<double>(samples); }
 };
 
@@ -159,6 +160,9 @@ Agreement compare_with_reference(const std::vector<LinkFrame>& frames, const Fix
     const cv::Mat& expected = expected_frame.drive_codes;
     const cv::Mat& got = got_frame.drive_codes;
     if (config.decoder.panel.kind == PanelKind::Lcd) {
+      agreement.max_unreachable_difference =
+          std::max(agreement.max_unreachable_difference, std::abs(expected_frame.stats.lcd_unreachable_fraction -
+                                                                  got_frame.stats.lcd_unreachable_fraction));
       cv::Mat merged_expected;
       cv::Mat merged_got;
       cv::pow(expected_frame.emitted_linear, 1.0 / config.decoder.panel.lcd.gamma, merged_expected);
@@ -193,12 +197,14 @@ void expect_agreement(const Agreement& a, const std::string& what) {
 // pixel's next frames, without decay. Codes may then differ by a few LSB while the merge M(v_t, v_{t-1}) the eye
 // sees stays within one code; that, and the fraction of identical codes, is what is asserted.
 void expect_lcd_agreement(const Agreement& a, const std::string& what) {
-  std::printf("[ fixed vs reference ] %-32s %9llu codes  identical %8.4f %%  max %d LSB  merge within %.3f codes\n",
+  std::printf("[ fixed vs reference ] %-32s %9llu codes  identical %8.4f %%  max %d LSB  merge within %.3f codes  "
+              "unreachable fraction within %.4f\n",
               what.c_str(), static_cast<unsigned long long>(a.samples), 100.0 * a.identical_fraction(), a.max_lsb,
-              a.max_merged_codes);
+              a.max_merged_codes, a.max_unreachable_difference);
   EXPECT_GE(a.identical_fraction(), 0.999) << what;
   EXPECT_LE(a.max_lsb, 4) << what;
   EXPECT_LE(a.max_merged_codes, 1.0) << what;
+  EXPECT_LE(a.max_unreachable_difference, 0.002) << what;
 }
 
 TEST(FixedDecoder, AgreesWithReferenceOnEveryScene) {

@@ -221,3 +221,46 @@ TEST(Cli, LosslessCurveFallsWithTheReduction) {
   EXPECT_LT(r05, full);
   EXPECT_NE(run_trm("lossless --scene panorama --reduction 0 --size 8x8").exit_code, 0);
 }
+
+TEST(Cli, RunHoldsTheFixedPointDecoderToTheReference) {
+  TempDir tmp;
+  const Result r = run_trm("run --scene panorama --frames 4 --size 64x48 --out " + tmp.str("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(tmp.path() / "out" / "report.json");
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["parameters"]["impl"], "fixed");
+  const auto& vs = report["summary"]["vs_reference"];
+  EXPECT_EQ(vs["codes_compared"].get<std::int64_t>(), 4 * 64 * 48 * 3);
+  EXPECT_GE(vs["identical_fraction"].get<double>(), 0.999);
+  EXPECT_LE(vs["max_lsb"].get<double>(), 1.0);
+  EXPECT_GT(report["hardware"]["total_bits"].get<std::int64_t>(), 0);
+  EXPECT_NE(r.output.find("vs reference"), std::string::npos);
+}
+
+TEST(Cli, DecodeWithEveryImplementationAgrees) {
+  TempDir tmp;
+  write_frames(tmp.path() / "in", 4, 33, 21);
+  const std::string input = "decode --input '" + tmp.str("in/frame_*.png") + "' --out ";
+  for (const char* impl : {"reference", "fixed", "fixed-frame"}) {
+    const Result r = run_trm(input + tmp.str(impl) + " --impl " + impl);
+    ASSERT_EQ(r.exit_code, 0) << impl << "\n" << r.output;
+  }
+  std::int64_t samples = 0, identical = 0;
+  for (int t = 0; t < 4; ++t) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/drive8_%04d.png", t);
+    const cv::Mat reference = cv::imread(tmp.str("reference") + name, cv::IMREAD_UNCHANGED);
+    const cv::Mat fixed = cv::imread(tmp.str("fixed") + name, cv::IMREAD_UNCHANGED);
+    const cv::Mat frame = cv::imread(tmp.str("fixed-frame") + name, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(reference.empty() || fixed.empty() || frame.empty());
+    // The two schedules of the fixed-point arithmetic are bit-identical.
+    EXPECT_EQ(cv::norm(fixed, frame, cv::NORM_INF), 0.0);
+    cv::Mat difference;
+    cv::absdiff(fixed, reference, difference);
+    EXPECT_LE(cv::norm(difference, cv::NORM_INF), 1.0);
+    const auto n = static_cast<std::int64_t>(difference.total() * 3);
+    samples += n;
+    identical += n - cv::countNonZero(difference.reshape(1));
+  }
+  EXPECT_GE(static_cast<double>(identical) / static_cast<double>(samples), 0.999);
+}

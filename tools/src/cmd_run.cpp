@@ -35,6 +35,9 @@ void warn_refresh(double refresh_hz) {
 
 void register_run(CLI::App& app, Action& action) {
   auto options = std::make_shared<PipelineOptions>();
+  // The main job decodes with the hardware model and holds it to the reference beside it.
+  options->impl = "fixed";
+  options->compare_reference = true;
   auto out = std::make_shared<std::string>("trm-out");
   CLI::App* cmd = app.add_subcommand("run", "Run the whole chain on a scene or input and write a report (default: "
                                             "discs, 1080x1200, 90 Hz, r = 1/2, vive OLED)");
@@ -83,6 +86,21 @@ void register_run(CLI::App& app, Action& action) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       Json report = recorder.report(wall);
       std::string link_lines;
+      if (result.hardware) {
+        Json hw;
+        hw["full_frame_latency_lines"] = result.hardware->full_latency_lines;
+        hw["reduced_frame_latency_lines"] = result.hardware->reduced_latency_lines;
+        Json buffers = Json::array();
+        std::int64_t total_bits = 0;
+        for (const auto& b : result.hardware->buffers) {
+          buffers.push_back({{"name", b.name}, {"lines", b.lines}, {"samples", b.samples}, {"bits", b.bits},
+                             {"total_bits", b.total_bits()}});
+          total_bits += b.total_bits();
+        }
+        hw["buffers"] = buffers;
+        hw["total_bits"] = total_bits;
+        report["hardware"] = hw;
+      }
       if (result.link) {
         report["link"] = write_link_outputs(dir, *options, *result.link, recorder.full_width(), recorder.full_height());
         link_lines = link_summary_lines(*result.link);

@@ -97,7 +97,10 @@ void PipelineOptions::add_options(CLI::App& cmd) {
       "LCD: build each pair target on the previous wanted value (wanted, the design's rule) or on what the "
       "previous frame actually contributed (contributed)");
   cmd.add_option("--seed", seed, "Seed for scenes with randomness")->capture_default_str();
-  cmd.add_option("--impl", impl, "Decoder implementation: reference")->capture_default_str();
+  cmd.add_option("--impl", impl,
+                 "Decoder: reference (double), fixed (fixed-point, line-buffered streaming: the hardware model) or "
+                 "fixed-frame (the same arithmetic frame at a time)")
+      ->capture_default_str();
 }
 
 void PipelineOptions::add_link_options(CLI::App& cmd) {
@@ -152,8 +155,12 @@ void PipelineOptions::validate() const {
   }
   if (frames < 0) throw std::invalid_argument("--frames must be >= 0");
   if (output_bits != 8 && output_bits != 10) throw std::invalid_argument("output bits must be 8 or 10");
-  if (impl != "reference") {
-    throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference)");
+  if (impl != "reference" && impl != "fixed" && impl != "fixed-frame") {
+    throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference, fixed, fixed-frame)");
+  }
+  if (impl != "reference" && (ber > 0.0 || !burst.empty() || drop > 0.0)) {
+    throw std::invalid_argument("--impl " + impl + " with link faults: concealment of lost lines is modelled in the "
+                                "reference decoder only; use --impl reference");
   }
   (void)parse_panel(panel);
   if (link_enabled()) (void)link_config(width, height);
@@ -204,6 +211,14 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   decoder_config.output_bits = options.output_bits;
   decoder_config.lcd_history = options.lcd_history;
   ReferenceDecoder decoder(decoder_config);
+  FixedDecoderConfig fixed_config;
+  fixed_config.decoder = decoder_config;
+  std::optional<FixedStreamingDecoder> streaming;
+  std::optional<FixedFrameDecoder> frame_at_a_time;
+  if (options.impl == "fixed") streaming.emplace(fixed_config);
+  if (options.impl == "fixed-frame") frame_at_a_time.emplace(fixed_config);
+  const bool fixed = streaming || frame_at_a_time;
+  const bool compare = fixed && options.compare_reference;
 
   std::optional<link::LinkSimulation> simulation;
   PipelineResult result;
@@ -233,7 +248,23 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       const LinkFrame& view_sent = sent[static_cast<std::size_t>(eye)];
       const auto start = std::chrono::steady_clock::now();
       DecodedFrame decoded;
-      if (simulation) {
+      DecodedFrame reference;
+      double decode_seconds = -1.0;  // of the decoder under test, not of the reference beside it
+      if (fixed) {
+        const LinkFrame* to_decode = &view_sent;
+        LinkFrame arrived_frame;
+        if (simulation) {
+          // Fault options are rejected with a fixed impl, so every view arrives whole.
+          for (const auto& r : received) {
+            if (r.meta.eye == eye && r.meta.index == t) arrived_frame = LinkFrame{r.meta, r.codes};
+          }
+          if (arrived_frame.codes.empty()) throw std::runtime_error("link lost a view on a fault-free link");
+          to_decode = &arrived_frame;
+        }
+        decoded = streaming ? streaming->decode(*to_decode) : frame_at_a_time->decode(*to_decode);
+        decode_seconds = seconds_since(start);
+        if (compare) reference = decoder.decode(*to_decode);
+      } else if (simulation) {
         const link::ReceivedFrame* arrived = nullptr;
         for (const auto& r : received) {
           if (r.meta.eye == eye && r.meta.index == t) arrived = &r;
@@ -253,12 +284,14 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       view.linear_full = &linear;
       view.sent = &view_sent;
       view.decoded = &decoded;
+      if (compare) view.reference = &reference;
       view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];
-      view.decode_seconds = seconds_since(start);
+      view.decode_seconds = decode_seconds >= 0.0 ? decode_seconds : seconds_since(start);
       sink(view);
     }
   }
   result.frames = frames;
+  if (streaming) result.hardware = streaming->report(cv::Size(source->width(), source->height()));
   if (simulation) {
     simulation->finish();
     result.link->frames = simulation->meter().frames();

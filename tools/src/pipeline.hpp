@@ -3,6 +3,7 @@
 #pragma once
 
 #include "trm/encoder.hpp"
+#include "trm/fixed_decoder.hpp"
 #include "trm/link_simulation.hpp"
 #include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
@@ -29,7 +30,8 @@ struct PipelineOptions {
   double sensitivity = 10.0;
   std::string panel = "vive";
   int output_bits = 8;
-  std::string impl = "reference";
+  std::string impl = "reference";     // reference | fixed (streaming, the hardware model) | fixed-frame
+  bool compare_reference = false;     // with a fixed impl: also run the reference and compare codes
   LcdHistory lcd_history = LcdHistory::Wanted;
 
   // Simulated display link (off when link_preset is empty and no fault or capture is asked for).
@@ -64,6 +66,7 @@ struct DecodedView {
   const cv::Mat* linear_full = nullptr;   // what was rendered (full resolution, linear)
   const LinkFrame* sent = nullptr;        // what crossed the link
   const DecodedFrame* decoded = nullptr;  // what the decoder produced
+  const DecodedFrame* reference = nullptr;  // the reference decoder's output, when compared beside a fixed impl
   double encode_seconds = 0.0;
   double decode_seconds = 0.0;
 };
@@ -80,6 +83,7 @@ struct LinkOutcome {
 
 struct PipelineResult {
   std::int64_t frames = 0;            // link frames (time steps) processed
+  std::optional<FixedStreamingReport> hardware;  // impl fixed: latency, line buffers and frame stores
   std::optional<LinkOutcome> link;    // when the link was simulated
 };
 

@@ -102,6 +102,19 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     rec["dropped_sum"] = d.stats.dropped_sum;
   }
   if (panel_.kind == PanelKind::Lcd) rec["lcd_unreachable_fraction"] = d.stats.lcd_unreachable_fraction;
+  if (view.reference) {
+    cv::Mat difference;
+    cv::absdiff(d.drive_codes, view.reference->drive_codes, difference);
+    const cv::Mat flat = difference.reshape(1);
+    const auto samples = static_cast<std::int64_t>(flat.total());
+    const std::int64_t identical = samples - cv::countNonZero(flat);
+    const double max_difference = cv::norm(flat, cv::NORM_INF);
+    compared_codes_ += samples;
+    identical_codes_ += identical;
+    max_code_difference_ = std::max(max_code_difference_, max_difference);
+    rec["vs_reference"] = {{"identical_fraction", static_cast<double>(identical) / static_cast<double>(samples)},
+                           {"max_lsb", max_difference}};
+  }
   rec["seconds"] = {{"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
   frames_.push_back(std::move(rec));
 
@@ -168,6 +181,11 @@ Json RunRecorder::report(double wall_seconds) const {
   s["pairs_exact"] = exact_pairs_;
   s["mean_psnr_db"] = finite_psnr_pairs_ ? json_number(sum_psnr_ / static_cast<double>(finite_psnr_pairs_)) : Json(nullptr);
   s["min_psnr_db"] = finite_psnr_pairs_ ? json_number(min_psnr_) : Json(nullptr);
+  if (compared_codes_ > 0) {
+    s["vs_reference"] = {{"codes_compared", compared_codes_},
+                         {"identical_fraction", static_cast<double>(identical_codes_) / static_cast<double>(compared_codes_)},
+                         {"max_lsb", max_code_difference_}};
+  }
   s["mean_seconds"] = {{"encode", n > 0 ? sum_encode_ / n : 0.0}, {"decode", n > 0 ? sum_decode_ / n : 0.0}};
   s["wall_seconds"] = wall_seconds;
   r["summary"] = s;
@@ -203,6 +221,12 @@ std::string RunRecorder::summary_table() const {
     psnr = "all " + std::to_string(exact_pairs_) + " pairs exact";
   }
   row("perceived pair vs full rate (PSNR)", psnr);
+  if (compared_codes_ > 0) {
+    row(("decoder " + options_.impl + " vs reference").c_str(),
+        fmt("%.4f %% of codes identical", 100.0 * static_cast<double>(identical_codes_) /
+                                               static_cast<double>(compared_codes_)) +
+            fmt(", max %.0f LSB", max_code_difference_));
+  }
   row("encode / decode per view", fmt("%.1f ms", 1e3 * s["mean_seconds"]["encode"].get<double>()) + " / " +
                                       fmt("%.1f ms", 1e3 * s["mean_seconds"]["decode"].get<double>()));
   return out.str();

@@ -53,6 +53,9 @@ class RunRecorder {
   std::int64_t full_views_ = 0;
   double sum_psnr_ = 0, min_psnr_ = 1e300;
   std::int64_t finite_psnr_pairs_ = 0, exact_pairs_ = 0;
+  // Fixed-point decoder against the reference beside it: output codes compared.
+  std::int64_t compared_codes_ = 0, identical_codes_ = 0;
+  double max_code_difference_ = 0.0;
 };
 
 // Rough PSNR (dB) between two linear images, measured on their sRGB encodings scaled to [0, 1];
