@@ -2,6 +2,7 @@
 // the reference decoder, calling the shared per-pixel arithmetic (fixed_kernels.hpp).
 #include "fixed_kernels.hpp"
 
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -49,16 +50,48 @@ FixedFrameDecoder& FixedFrameDecoder::operator=(FixedFrameDecoder&&) noexcept = 
 const FixedDecoderConfig& FixedFrameDecoder::config() const { return core_->config(); }
 const FixedStageCounts& FixedFrameDecoder::last_counts() const { return core_->last_counts(); }
 
-DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame) {
+DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame) { return decode_impl(frame, nullptr); }
+
+DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, FixedStageTaps& taps) {
+  DecodedFrame decoded = decode_impl(frame, &taps);
+  // The planes held outside the per-pixel stages: received codes and drive codes.
+  const auto copy_codes = [](const cv::Mat& m, FixedStagePlane& p) {
+    for (int y = 0; y < m.rows; ++y) {
+      const std::uint16_t* row = m.ptr<std::uint16_t>(y);
+      std::copy(row, row + 3 * m.cols, p.values.begin() + static_cast<std::ptrdiff_t>(y) * 3 * m.cols);
+    }
+  };
+  copy_codes(frame.codes, taps[FixedStage::Codes]);
+  copy_codes(decoded.drive_codes, taps[FixedStage::Drive]);
+  return decoded;
+}
+
+DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& frame, FixedStageTaps* taps) {
   fixed_detail::EyeState& eye = core_->begin(frame, "FixedFrameDecoder");
   const Geometry& g = core_->kernels().geometry(eye.full_size);
   fixed_detail::FrameOutput out = core_->start_output(frame);
   out.full = frame.meta.parity == Parity::Full;
   core_->begin_lcd(out, eye);
+  if (taps != nullptr) {
+    core_->start_taps(out, *taps, g, out.full,
+                      !out.full && eye.have_residual && eye.residual_index + 1 == frame.meta.index);
+  }
   const auto row_of = [](const cv::Mat& m, int y) { return m.ptr<std::uint16_t>(y); };
 
   if (frame.meta.parity == Parity::Full) {
     const cv::Mat low_store = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t with tie flags
+    if (taps != nullptr) {
+      const int b = core_->config().decoder.link.bits;
+      std::vector<std::int64_t>& d = (*taps)[FixedStage::Reduced].values;
+      for (int k = 0; k < low_store.rows; ++k) {
+        const std::uint16_t* in = low_store.ptr<std::uint16_t>(k);
+        for (int i = 0; i < 3 * low_store.cols; ++i) {
+          const bool tie = (in[i] & fixed_detail::kTieFlag) != 0;
+          d[static_cast<std::size_t>(k) * 3 * static_cast<std::size_t>(low_store.cols) + static_cast<std::size_t>(i)] =
+              fixed_detail::code_of(in[i]) | (tie ? std::int64_t{1} << b : 0);
+        }
+      }
+    }
     cv::Mat low(low_store.size(), CV_16UC3);                                          // d_t codes
     for (int k = 0; k < low.rows; ++k) {
       const std::uint16_t* in = low_store.ptr<std::uint16_t>(k);

@@ -484,14 +484,7 @@ Raw FixedKernels::motion_weight(Raw luma_previous, Raw luma_alpha, bool& underfl
   if (difference == 0) return one();  // c = 0 (including a zero sum): w = 1 exactly, for every s
   if (sensitivity_infinite_) return 0;
   if (config_.decoder.sensitivity == 0.0) return one();
-  // Eq. 5: c = difference / sum = difference * mantissa 2^-24 2^-e, uQ1.F (clamped to 1 against LUT error).
-  const fx::NormalisedReciprocal reciprocal =
-      fx::reciprocal_normalised(*reciprocal_, static_cast<std::uint64_t>(sum), F);
-  const fx::detail::int128 product = static_cast<fx::detail::int128>(difference) * reciprocal.mantissa_raw;
-  const int shift = reciprocal_->shape().output_frac_bits + reciprocal.exponent;
-  const fx::detail::int128 c128 = shift >= 0 ? (product + (static_cast<fx::detail::int128>(1) << shift >> 1)) >> shift
-                                             : product << -shift;
-  const Raw contrast = static_cast<Raw>(std::min<fx::detail::int128>(c128, one()));
+  const Raw contrast = contrast_of(difference, sum);
   // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
   const Raw x = round_shift(sensitivity_raw_ * contrast,
                             config_.sensitivity_frac_bits + F - config_.exp_input_frac_bits);
@@ -503,6 +496,22 @@ Raw FixedKernels::motion_weight(Raw luma_previous, Raw luma_alpha, bool& underfl
   const Raw fraction = x & ((Raw{1} << config_.exp_input_frac_bits) - 1);
   const Raw e_fraction = exp_fraction_->evaluate_raw(static_cast<std::uint32_t>(fraction));
   return round_shift(exp_integer_rom_[static_cast<std::size_t>(integer_part)] * e_fraction, F);
+}
+
+Raw FixedKernels::contrast_of(Raw difference, Raw sum) const {
+  // Eq. 5: c = difference / sum = difference * mantissa 2^-24 2^-e, uQ1.F (clamped to 1 against LUT error).
+  const fx::NormalisedReciprocal reciprocal =
+      fx::reciprocal_normalised(*reciprocal_, static_cast<std::uint64_t>(sum), config_.linear_frac_bits);
+  const fx::detail::int128 product = static_cast<fx::detail::int128>(difference) * reciprocal.mantissa_raw;
+  const int shift = reciprocal_->shape().output_frac_bits + reciprocal.exponent;
+  const fx::detail::int128 c128 = shift >= 0 ? (product + (static_cast<fx::detail::int128>(1) << shift >> 1)) >> shift
+                                             : product << -shift;
+  return static_cast<Raw>(std::min<fx::detail::int128>(c128, one()));
+}
+
+Raw FixedKernels::motion_contrast(Raw luma_previous, Raw luma_alpha) const {
+  const Raw difference = luma_previous > luma_alpha ? luma_previous - luma_alpha : luma_alpha - luma_previous;
+  return difference == 0 ? 0 : contrast_of(difference, luma_previous + luma_alpha);
 }
 
 WeightedSample FixedKernels::add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const {
@@ -532,6 +541,94 @@ std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
 Raw FixedKernels::drive_value(Raw linear, int ch) const {
   if (linear >= one()) return Raw{1} << config_.drive_frac_bits;
   return drive_luts_[static_cast<std::size_t>(ch)]->evaluate_raw(static_cast<std::uint32_t>(linear >> drive_lut_shift_));
+}
+
+std::vector<FixedRomReport> FixedKernels::roms() const {
+  const auto lut = [](const std::string& name, const fx::InterpolatedLut& table, int count = 1) {
+    const fx::RomSize size = table.rom_size();
+    return FixedRomReport{name, size.entries, size.word_bits, count};
+  };
+  const int F = config_.linear_frac_bits;
+  const int top = max_output_code();
+  std::vector<FixedRomReport> out;
+  out.push_back({"I = lin(E): direct ROM per link code (uQ1." + std::to_string(F) + ")",
+                 static_cast<int>(code_rom_.size()), 1 + F, 1});
+  out.push_back(lut("L, alpha = lin(U(.)): interpolated EOTF LUT", *eotf_));
+  out.push_back(lut("Eq. 5 1/(Yp + Ya): normalised reciprocal LUT", *reciprocal_));
+  out.push_back({"Eq. 6 exp(-i), i = 0..15", static_cast<int>(exp_integer_rom_.size()), 1 + F, 1});
+  out.push_back(lut("Eq. 6 exp(-f), f in [0, 1): interpolated LUT", *exp_fraction_));
+  if (lcd_) {
+    out.push_back(lut("LCD target m = x^(1/gamma): octave-segmented LUT", *lcd_target_lut_));
+    out.push_back({"LCD M(0|1, v_{t-1})^gamma: clamped-drive luminance ROMs (sQ4." + std::to_string(F) + ")",
+                   top + 1, 4 + F, 2});
+  } else {
+    // The drive value LUT (DecodedFrame::drive) feeds reports only; the drive codes come from the thresholds.
+    out.push_back({"OLED drive thresholds T_k per channel (uQ1." + std::to_string(F) + ")", top + 1, 1 + F, 3});
+  }
+  return out;
+}
+
+// Operators per evaluation of each stage, counted from the functions above (worst case per evaluation; a
+// rounding "+ half LSB" before a shift counts as an adder, a clamp as two comparators, a shift or a bit-field
+// extraction as nothing). Rare paths are left out: the exact-tie correction of Eq. 4 (one more multiplier and two
+// adders where d_t held an exact half-code tie) and the LCD held first frame (a second search).
+//
+// | stage                          | per            | adders            | multipliers | comparators | ROM reads |
+// |--------------------------------|----------------|-------------------|-------------|-------------|-----------|
+// | I = lin(E)                     | sample         | 0                 | 0           | 0           | 1         |
+// | D horizontal (n_h taps)        | reduced sample | n_h               | n_h         | 1 (tie)     | 0         |
+// | D vertical + Q_b (n_v taps)    | reduced sample | n_v               | n_v         | 1 (tie)     | 0         |
+// | U bilinear (blend)             | sample         | 6                 | 6           | 0           | 0         |
+// | EOTF LUT (interpolated)        | sample         | 3                 | 1           | 0           | 2         |
+// | Eq. 2 beta, clamp, rho         | sample         | 2                 | 0           | 2           | 0         |
+// | residual store (round, sat.)   | sample         | 1                 | 0           | 2           | 0         |
+// | d_{t-1} exact-tie resolution   | sample         | 4                 | 0           | 5           | 0         |
+// | luma of L_{t-1} and alpha      | pixel          | 6                 | 6           | 0           | 0         |
+// | Eq. 5 contrast c               | pixel          | 6                 | 2           | 3           | 2         |
+// | Eq. 6 weight w                 | pixel          | 5                 | 3           | 1           | 3         |
+// | Eq. 4 alpha'                   | sample         | 2                 | 1           | 2           | 0         |
+// | OLED drive code (search)       | sample         | 0                 | 0           | o           | o         |
+// | LCD drive code (Eq. 7 inverse) | sample         | 4 + 6 o           | 2 + 8 o     | 2 + o       | 4         |
+std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) const {
+  const auto widest = [](const std::vector<PolyphaseTaps>& axis) {
+    std::size_t n = 0;
+    for (const auto& taps : axis) n = std::max(n, taps.weight.size());
+    return static_cast<int>(n);
+  };
+  const int n_h = widest(g.gauss_cols);
+  const int n_v = widest(g.gauss_rows);
+  const int o = config_.decoder.output_bits;
+  const std::int64_t pixels = static_cast<std::int64_t>(g.full.width) * g.full.height;
+  const std::int64_t samples = 3 * pixels;
+  const std::int64_t horizontal = 3 * static_cast<std::int64_t>(g.reduced.width) * g.full.height;
+  const std::int64_t vertical = 3 * static_cast<std::int64_t>(g.reduced.width) * g.reduced.height;
+  std::vector<FixedArithmeticReport> out = {
+      {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
+      {"D horizontal (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line", horizontal,
+       n_h, n_h, 1, 0},
+      {"D vertical + Q_b (" + std::to_string(n_v) + " taps)", "full", "reduced sample", vertical, n_v, n_v, 1, 0},
+      {"U bilinear of d_t", "full", "channel sample", samples, 6, 6, 0, 0},
+      {"EOTF LUT: L = lin(U(d_t))", "full", "channel sample", samples, 3, 1, 0, 2},
+      {"Eq. 2 beta = 2I - L, shown, rho", "full", "channel sample", samples, 2, 0, 2, 0},
+      {"residual store (round, saturate)", "full", "channel sample", samples, 1, 0, 2, 0},
+      {"U bilinear of i", "reduced", "channel sample", samples, 6, 6, 0, 0},
+      {"EOTF LUT: alpha = lin(U(i))", "reduced", "channel sample", samples, 3, 1, 0, 2},
+      {"d_{t-1} exact-tie resolution", "reduced", "channel sample", samples, 4, 0, 5, 0},
+      {"U bilinear of d_{t-1}", "reduced", "channel sample", samples, 6, 6, 0, 0},
+      {"EOTF LUT: L_{t-1} = lin(U(d_{t-1}))", "reduced", "channel sample", samples, 3, 1, 0, 2},
+      {"luma of L_{t-1} and alpha", "reduced", "pixel", pixels, 6, 6, 0, 0},
+      {"Eq. 5 motion contrast c", "reduced", "pixel", pixels, 6, 2, 3, 2},
+      {"Eq. 6 weight w = exp(-s c)", "reduced", "pixel", pixels, 5, 3, 1, 3},
+      {"Eq. 4 alpha' = clamp(alpha + w rho)", "reduced", "channel sample", samples, 2, 1, 2, 0},
+  };
+  if (lcd_) {
+    out.push_back({"LCD drive code (Eq. 7 inverse, " + std::to_string(o) + "-step search)", "both", "channel sample",
+                   samples, 4 + 6 * o, 2 + 8 * o, 2 + o, 4});
+  } else {
+    out.push_back({"OLED drive code (" + std::to_string(o) + "-step threshold search)", "both", "channel sample",
+                   samples, 0, 0, o, o});
+  }
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -628,12 +725,19 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometr
     const Raw low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
     const Raw full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
     const CompensatedSample s = kernels_.compensate(full_linear, low_linear);                                // Eq. 2
+    if (out.taps != nullptr) {
+      tap(out, FixedStage::Linear, y, x, ch, full_linear);
+      tap(out, FixedStage::LowPass, y, x, ch, low_linear);
+      tap(out, FixedStage::Beta, y, x, ch, s.shown + s.rho);
+      tap(out, FixedStage::Shown, y, x, ch, s.shown);
+    }
     t.clipped += s.clipped ? 1 : 0;
     t.counts.beta_clipped += s.clipped ? 1 : 0;
     // LCD: an unreachable drive's shortfall joins rho (Sec. 4.4) before the residual store.
     const Raw shortfall = emit(out, eye, y, x, ch, s.shown);
     const StoredResidual stored = kernels_.store_residual(s.rho + shortfall);
     residual_row[3 * x + ch] = static_cast<std::int32_t>(stored.value);
+    tap(out, FixedStage::Residual, y, x, ch, stored.value);
     t.counts.residual_saturated += stored.saturated ? 1 : 0;
     t.counts.residual_rounded += stored.rounded ? 1 : 0;
     const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
@@ -650,10 +754,15 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   Raw alpha[3];
   for (int ch = 0; ch < 3; ++ch) {
     alpha[ch] = kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
+    tap(out, FixedStage::Alpha, y, x, ch, alpha[ch]);
   }
   if (residual_row == nullptr) {
     // No full frame just before: alpha alone (U of codes stays within [0, 1]; the clamp only guards).
-    for (int ch = 0; ch < 3; ++ch) emit(out, eye, y, x, ch, std::clamp(alpha[ch], Raw{0}, kernels_.one()));
+    for (int ch = 0; ch < 3; ++ch) {
+      const Raw shown = std::clamp(alpha[ch], Raw{0}, kernels_.one());
+      tap(out, FixedStage::AlphaPrime, y, x, ch, shown);
+      emit(out, eye, y, x, ch, shown);
+    }
     return;
   }
   // L_{t-1} for the motion test, exact ties resolved towards the received codes; and the tie correction: the full
@@ -671,6 +780,11 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   FrameTally& t = out.tally;
   bool underflow = false;
   const Raw weight = kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);  // Eqs. 5-6
+  if (out.taps != nullptr) {
+    for (int ch = 0; ch < 3; ++ch) tap(out, FixedStage::PreviousLowPass, y, x, ch, previous[ch]);
+    tap(out, FixedStage::Contrast, y, x, 0, kernels_.motion_contrast(kernels_.luma(previous), kernels_.luma(alpha)));
+    tap(out, FixedStage::Weight, y, x, 0, weight);
+  }
   t.weight_sum += weight;
   t.counts.weight_underflow += underflow ? 1 : 0;
   for (int ch = 0; ch < 3; ++ch) {
@@ -682,8 +796,53 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
     const Raw magnitude = residual < 0 ? -residual : residual;
     t.residual_abs_sum += magnitude;
     t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
+    tap(out, FixedStage::AlphaPrime, y, x, ch, s.alpha_prime);
     emit(out, eye, y, x, ch, s.alpha_prime);
   }
+}
+
+void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full,
+                                  bool residual) const {
+  const FixedDecoderConfig& c = config();
+  const int F = c.linear_frac_bits;
+  const int b = c.decoder.link.bits;
+  const std::string linear = "uQ1." + std::to_string(F);
+  taps = FixedStageTaps();
+  const auto add = [&](FixedStage stage, const char* name, const std::string& format, int bits, bool is_signed,
+                       cv::Size size, int channels) {
+    FixedStagePlane& p = taps[stage];
+    p.present = true;
+    p.name = name;
+    p.format = format;
+    p.bits = bits;
+    p.is_signed = is_signed;
+    p.size = size;
+    p.channels = channels;
+    p.values.assign(static_cast<std::size_t>(size.area()) * static_cast<std::size_t>(channels), 0);
+  };
+  const std::string code = "uQ" + std::to_string(b) + ".0";
+  add(FixedStage::Codes, "codes", code, b, false, full ? g.full : g.reduced, 3);
+  if (full) {
+    add(FixedStage::Linear, "I", linear, 1 + F, false, g.full, 3);
+    add(FixedStage::Reduced, "d", code + " + exact-tie flag in bit " + std::to_string(b), b + 1, false, g.reduced, 3);
+    add(FixedStage::LowPass, "L", linear, 1 + F, false, g.full, 3);
+    add(FixedStage::Beta, "beta", "sQ3." + std::to_string(F), 3 + F, true, g.full, 3);
+    add(FixedStage::Shown, "shown", linear, 1 + F, false, g.full, 3);
+    add(FixedStage::Residual, "rho",
+        std::string("sQ") + std::to_string(c.residual.int_bits) + "." + std::to_string(c.residual.frac_bits),
+        c.residual.width(), true, g.full, 3);
+  } else {
+    add(FixedStage::Alpha, "alpha", linear, 1 + F, false, g.full, 3);
+    if (residual) {
+      add(FixedStage::PreviousLowPass, "L_prev", linear, 1 + F, false, g.full, 3);
+      add(FixedStage::Contrast, "c", linear, 1 + F, false, g.full, 1);
+      add(FixedStage::Weight, "w", linear, 1 + F, false, g.full, 1);
+    }
+    add(FixedStage::AlphaPrime, "alpha_prime", linear, 1 + F, false, g.full, 3);
+  }
+  const int o = c.decoder.output_bits;
+  add(FixedStage::Drive, "drive", "uQ" + std::to_string(o) + ".0", o, false, g.full, 3);
+  out.taps = &taps;
 }
 
 DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, bool full, bool residual_applied) {

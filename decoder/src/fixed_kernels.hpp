@@ -158,6 +158,8 @@ class FixedKernels {
   Raw luma(const Raw* rgb) const;
   // Eqs. 5-6: c = |Yp - Ya| / (Yp + Ya) (0 where the sum is 0), w = exp(-s c); uQ1.F. Sets underflow when s c >= 16.
   Raw motion_weight(Raw luma_previous, Raw luma_alpha, bool& underflow) const;
+  // Eq. 5 alone (the c that motion_weight computes, for test vectors): uQ1.F, 0 where Yp = Ya.
+  Raw motion_contrast(Raw luma_previous, Raw luma_alpha) const;
   // Eq. 4: alpha' = clamp(alpha + w (rho + tie_correction), 0, 1); tie_correction = L_used - L_resolved (uQ.F).
   WeightedSample add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const;
 
@@ -166,6 +168,11 @@ class FixedKernels {
   // Drive value v = x^(1/gamma) for reports, uQ1.drive_frac_bits.
   Raw drive_value(Raw linear, int ch) const;
   double emitted_of_code(std::uint16_t code, int ch) const { return emission_[ch][code]; }
+
+  // Every ROM of this configuration (name, words, word bits, copies).
+  std::vector<FixedRomReport> roms() const;
+  // The operator table of the per-pixel stages at the geometry's sizes (see the table in fixed_kernels.cpp).
+  std::vector<FixedArithmeticReport> arithmetic(const Geometry& g) const;
 
   // Exact conversions (the raw values have at most 53 significant bits; the scales are powers of two).
   double linear_to_double(Raw v) const { return static_cast<double>(v) * linear_lsb_; }
@@ -199,6 +206,8 @@ class FixedKernels {
   std::array<std::vector<Raw>, 2> lcd_end_luminance_;
   // The merge scaled to an integer: (2 Mx)^2 2^P M(t / (2 Mx), j / Mx).
   Raw scaled_merge(const std::array<Raw, 4>& p, Raw t, Raw j) const;
+  // c = difference / sum through the reciprocal LUT, clamped to 1; difference > 0.
+  Raw contrast_of(Raw difference, Raw sum) const;
   Raw lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const;
 };
 
@@ -219,6 +228,7 @@ struct FrameOutput {
   FrameTally tally;
   bool lcd_held = false;  // LCD: the eye's first frame (no v_{t-1} yet)
   bool full = false;
+  FixedStageTaps* taps = nullptr;  // test vectors: stage planes to fill (frame-at-a-time schedule only)
 };
 
 // The state and plumbing shared by both schedules: configuration, ROMs, eye states, input checks and output.
@@ -247,6 +257,15 @@ class FixedDecoderCore {
   void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
                      const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
                      const std::int32_t* residual_row) const;
+  // Test vectors: marks the stages of this frame kind present in taps, sized and formatted, and attaches them.
+  void start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full, bool residual) const;
+  // Records one value of a stage plane (no-op without taps).
+  static void tap(FrameOutput& out, FixedStage stage, int y, int x, int ch, Raw value) {
+    if (out.taps == nullptr) return;
+    FixedStagePlane& p = (*out.taps)[stage];
+    p.values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(p.size.width) + static_cast<std::size_t>(x)) *
+                 static_cast<std::size_t>(p.channels) + static_cast<std::size_t>(ch)] = value;
+  }
   // Fills FrameStats from the tally and remembers the counts.
   DecodedFrame finish(FrameOutput&& out, bool full, bool residual_applied);
 

@@ -136,6 +136,10 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
   FixedStreamingReport r;
   r.full_latency_lines = p.full_latency;
   r.reduced_latency_lines = p.reduced_latency;
+  r.full = g.full;
+  r.reduced = g.reduced;
+  r.roms = core_->kernels().roms();
+  r.arithmetic = core_->kernels().arithmetic(g);
   r.buffers = {
       {"line: vertical Gaussian (horizontal D results, uQb.L)", p.gauss_lines, 3 * g.reduced.width, b + c.gaussian_line_frac_bits},
       {"line: E_t delay for I_t (link codes)", p.delay_lines, 3 * g.full.width, b},
@@ -144,6 +148,10 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
       {"frame: residual rho (" + c.residual.to_string() + ")", g.full.height, 3 * g.full.width, c.residual.width()},
       {"frame: d_t for the motion test (codes + exact-tie flag)", g.reduced.height, 3 * g.reduced.width, b + 1},
   };
+  const std::int64_t full_samples = 3 * static_cast<std::int64_t>(g.full.area());
+  const std::int64_t reduced_samples = 3 * static_cast<std::int64_t>(g.reduced.area());
+  r.paper_frame_store_bits = full_samples * b + full_samples * c.residual.width();
+  r.model_frame_store_bits = reduced_samples * (b + 1) + full_samples * c.residual.width();
   if (c.decoder.panel.kind == PanelKind::Lcd) {
     r.buffers.push_back({"frame: LCD v_{t-1} (drive codes)", g.full.height, 3 * g.full.width, c.decoder.output_bits});
     r.buffers.push_back({"frame: LCD x_{t-1} (sQ3." + std::to_string(c.linear_frac_bits) + ")", g.full.height,

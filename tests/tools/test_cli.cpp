@@ -264,3 +264,29 @@ TEST(Cli, DecodeWithEveryImplementationAgrees) {
   }
   EXPECT_GE(static_cast<double>(identical) / static_cast<double>(samples), 0.999);
 }
+
+TEST(Cli, CaptureReplaysIntoDecodeAndFeed) {
+  TempDir tmp;
+  const Result run = run_trm("run --frames 4 --size 32x24 --link dp1.2 --ber 1e-5 --seed 3 --out " + tmp.str("run"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ASSERT_TRUE(fs::exists(tmp.path() / "run" / "link.trmcap"));
+  ASSERT_TRUE(fs::exists(tmp.path() / "run" / "frames.csv"));
+  ASSERT_TRUE(fs::exists(tmp.path() / "run" / "link_bits.png"));
+  const Result decode = run_trm("decode --capture " + tmp.str("run/link.trmcap") + " --out " + tmp.str("dec"));
+  ASSERT_EQ(decode.exit_code, 0) << decode.output;
+  EXPECT_TRUE(fs::exists(tmp.path() / "dec" / "drive8_0003.png"));
+  const Result feed = run_trm("feed --capture " + tmp.str("run/link.trmcap") + " --file " + tmp.str("rig.bin") + " --fps 0");
+  ASSERT_EQ(feed.exit_code, 0) << feed.output;
+  // Four 32x24 8-bit RGB frames went out, with protocol framing around them.
+  EXPECT_GT(fs::file_size(tmp.path() / "rig.bin"), 4u * 32 * 24 * 3);
+
+  // A truncated capture is refused with its name, and leaves no output behind.
+  const auto size = fs::file_size(tmp.path() / "run" / "link.trmcap");
+  fs::copy_file(tmp.path() / "run" / "link.trmcap", tmp.path() / "cut.trmcap");
+  fs::resize_file(tmp.path() / "cut.trmcap", size / 2);
+  const Result cut = run_trm("decode --capture " + tmp.str("cut.trmcap") + " --out " + tmp.str("cutdec"));
+  EXPECT_NE(cut.exit_code, 0);
+  EXPECT_NE(cut.output.find("cut.trmcap"), std::string::npos) << cut.output;
+  EXPECT_FALSE(fs::exists(tmp.path() / "cutdec"));
+  EXPECT_NE(run_trm("run --frames 2 --size 8x8 --link custom:0:0.8 --out " + tmp.str("zero")).exit_code, 0);
+}

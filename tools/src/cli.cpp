@@ -20,6 +20,8 @@ int run_main(int argc, char** argv) {
   register_decode(app, action);
   register_lossless(app, action);
   register_feed(app, action);
+  register_hw_report(app, action);
+  register_vectors(app, action);
 
   try {
     app.parse(argc, argv);

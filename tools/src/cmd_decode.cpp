@@ -46,57 +46,29 @@ cv::Mat drive_16bit(const cv::Mat& drive) {
 // configuration (r, sigma, transfer, bits, ...) comes from the capture's header; panel, sensitivity and output
 // bits from the command line.
 int decode_capture(const PipelineOptions& options, const std::string& capture_path, const std::string& out) {
-  link::CaptureReplay replay(capture_path);
-  nlohmann::json meta;
-  try {
-    meta = nlohmann::json::parse(replay.metadata());
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error("capture '" + capture_path + "' has no readable configuration in its header: " + e.what());
-  }
-  DecoderConfig config;
-  try {
-    config.link.reduction = meta.at("reduction").get<double>();
-    config.link.sigma = meta.at("sigma").get<double>();
-    config.link.phase = meta.at("phase").get<int>();
-    config.link.transfer = parse_transfer(meta.at("transfer").get<std::string>());
-    config.link.resample_space = parse_resample_space(meta.at("resample_space").get<std::string>());
-    config.link.bits = meta.at("bits").get<int>();
-    config.link.stereo = meta.at("stereo").get<bool>();
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error("capture '" + capture_path + "': incomplete configuration in its header: " + e.what());
-  }
-  config.sensitivity = options.sensitivity;
-  config.panel = parse_panel(options.panel);
-  config.output_bits = options.output_bits;
-  config.lcd_history = options.lcd_history;
-  ReferenceDecoder decoder(config);
-
   OutputDir dir(out);
   const std::string code_prefix = "drive" + std::to_string(options.output_bits);
   Json frames = Json::array();
-  std::int64_t concealed_lines = 0;
-  while (auto received = replay.next_frame()) {
-    const DecodedFrame decoded = decoder.decode(LinkFrame{received->meta, received->codes}, received->line_intact);
-    const std::int64_t t = received->meta.index;
-    const std::string eye = received->meta.eye == 0 ? "" : "_right";
-    dir.write_png(numbered("drive" + eye, t), drive_16bit(decoded.drive));
-    cv::Mat codes = decoded.drive_codes;
-    if (options.output_bits == 8) codes.convertTo(codes, CV_8U);
-    dir.write_png(numbered(code_prefix + eye, t), codes);
-    concealed_lines += decoded.stats.concealed_lines;
-    frames.push_back({{"t", t},
-                      {"eye", received->meta.eye},
-                      {"parity", to_string(received->meta.parity)},
-                      {"intact_lines", received->intact_lines()},
-                      {"concealed_lines", decoded.stats.concealed_lines},
-                      {"clipped_fraction", decoded.stats.clipped_fraction}});
-  }
-  if (frames.empty()) throw std::runtime_error("capture '" + capture_path + "' holds no frames");
-  const link::ReceiverCounters& c = replay.counters();
+  const CaptureDecodeResult result =
+      decode_capture_stream(options, capture_path, [&](const link::ReceivedFrame& received, const DecodedFrame& decoded) {
+        const std::int64_t t = received.meta.index;
+        const std::string eye = received.meta.eye == 0 ? "" : "_right";
+        dir.write_png(numbered("drive" + eye, t), drive_16bit(decoded.drive));
+        cv::Mat codes = decoded.drive_codes;
+        if (options.output_bits == 8) codes.convertTo(codes, CV_8U);
+        dir.write_png(numbered(code_prefix + eye, t), codes);
+        frames.push_back({{"t", t},
+                          {"eye", received.meta.eye},
+                          {"parity", to_string(received.meta.parity)},
+                          {"intact_lines", received.intact_lines()},
+                          {"concealed_lines", decoded.stats.concealed_lines},
+                          {"clipped_fraction", decoded.stats.clipped_fraction}});
+      });
+  const link::ReceiverCounters& c = result.receiver;
   Json report;
   report["tool"] = "trm";
   report["capture"] = capture_path;
-  report["link_configuration"] = meta;
+  report["link_configuration"] = Json::parse(result.link_configuration);
   report["parameters"] = {{"sensitivity", options.sensitivity},
                           {"panel", options.panel},
                           {"output_bits", options.output_bits}};
@@ -104,12 +76,12 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
                         {"crc_failures", c.crc_failures},         {"malformed", c.malformed},
                         {"inconsistent", c.inconsistent},         {"duplicates", c.duplicates},
                         {"stale", c.stale}};
-  report["summary"] = {{"views", frames.size()}, {"concealed_lines", concealed_lines}};
+  report["summary"] = {{"views", result.views}, {"concealed_lines", result.concealed_lines}};
   report["frames"] = frames;
   dir.write_text("report.json", report.dump(2) + "\n");
   dir.commit();
-  std::cout << "trm decode: " << frames.size() << " views from " << capture_path << " -> " << dir.target().string()
-            << "/ (" << c.crc_failures << " damaged packets, " << concealed_lines << " lines concealed)\n";
+  std::cout << "trm decode: " << result.views << " views from " << capture_path << " -> " << dir.target().string()
+            << "/ (" << c.crc_failures << " damaged packets, " << result.concealed_lines << " lines concealed)\n";
   return 0;
 }
 

@@ -26,6 +26,7 @@ namespace {
 struct FeedSettings {
   bool list = false;
   std::string usb, hid, file;
+  std::string capture;  // feed the frames decoded from this .trmcap instead of running the pipeline
   // USB bulk
   std::string serial, bus_port;
   int interface_number = -1;
@@ -209,8 +210,8 @@ int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
   bool warned = false;
   int exit_code = 0;
   try {
-    run_pipeline(pipeline, [&](const DecodedView& view) {
-      rig::RigFrame frame = to_rig_frame(*view.decoded, pipeline.output_bits);
+    const auto feed_decoded = [&](const DecodedFrame& decoded) {
+      rig::RigFrame frame = to_rig_frame(decoded, pipeline.output_bits);
       if (roi || s.downscale > 1)
         frame = rig::crop_and_decimate(frame, roi.value_or(rig::Region{0, 0, frame.width, frame.height}), s.downscale);
       if (!warned) {
@@ -218,7 +219,13 @@ int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
         warned = true;
       }
       feeder.feed(frame);
-    });
+    };
+    if (!s.capture.empty()) {
+      decode_capture_stream(pipeline, s.capture,
+                            [&](const link::ReceivedFrame&, const DecodedFrame& decoded) { feed_decoded(decoded); });
+    } else {
+      run_pipeline(pipeline, [&](const DecodedView& view) { feed_decoded(*view.decoded); });
+    }
     summary["status"] = "ok";
   } catch (const rig::RigError& e) {
     exit_code = record_error(e);
@@ -238,6 +245,8 @@ void register_feed(CLI::App& app, Action& action) {
   pipeline->add_options(*cmd);
   FeedSettings& s = *settings;
 
+  cmd->add_option("--capture", s.capture, "Feed the frames decoded from a recorded packet stream (.trmcap)")
+      ->excludes(cmd->get_option("--input"));
   cmd->add_flag("--list", s.list, "List candidate USB and HID devices (VID:PID, strings, endpoints) and exit");
   auto* usb = cmd->add_option("--usb", s.usb, "USB bulk rig, VID:PID in hex (e.g. 1234:5678)");
   auto* hid = cmd->add_option("--hid", s.hid, "HID rig, VID:PID in hex or a hidapi path (/dev/hidrawN)");

@@ -1,6 +1,7 @@
 // `trm run`: the main job. Renders a scene (or reads an input), runs the GPU-side encoder and the decoder,
 // and writes report.json plus PNG previews of the first frame pair into the output directory.
 #include "commands.hpp"
+#include "hw_report.hpp"
 #include "link_report.hpp"
 #include "output_dir.hpp"
 #include "pipeline.hpp"
@@ -45,8 +46,15 @@ void register_run(CLI::App& app, Action& action) {
   options->add_link_options(*cmd);
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   action = nullptr;
-  cmd->callback([options, out, &action] {
-    action = [options, out] {
+  cmd->callback([options, out, cmd, &action] {
+    const bool impl_given = cmd->count("--impl") > 0;
+    action = [options, out, impl_given] {
+      const bool faults = options->ber > 0.0 || !options->burst.empty() || options->drop > 0.0;
+      if (faults && !impl_given && options->impl != "reference") {
+        // Concealment of lost lines is modelled in the reference decoder only.
+        std::cerr << "trm: note: link faults requested: decoding with --impl reference (conceals lost lines)\n";
+        options->impl = "reference";
+      }
       options->validate();
       warn_refresh(options->refresh_hz);
       const auto start = std::chrono::steady_clock::now();
@@ -86,21 +94,7 @@ void register_run(CLI::App& app, Action& action) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       Json report = recorder.report(wall);
       std::string link_lines;
-      if (result.hardware) {
-        Json hw;
-        hw["full_frame_latency_lines"] = result.hardware->full_latency_lines;
-        hw["reduced_frame_latency_lines"] = result.hardware->reduced_latency_lines;
-        Json buffers = Json::array();
-        std::int64_t total_bits = 0;
-        for (const auto& b : result.hardware->buffers) {
-          buffers.push_back({{"name", b.name}, {"lines", b.lines}, {"samples", b.samples}, {"bits", b.bits},
-                             {"total_bits", b.total_bits()}});
-          total_bits += b.total_bits();
-        }
-        hw["buffers"] = buffers;
-        hw["total_bits"] = total_bits;
-        report["hardware"] = hw;
-      }
+      if (result.hardware) report["hardware"] = hardware_json(*result.hardware);
       if (result.link) {
         report["link"] = write_link_outputs(dir, *options, *result.link, recorder.full_width(), recorder.full_height());
         link_lines = link_summary_lines(*result.link);

@@ -9,5 +9,7 @@ void register_run(CLI::App& app, Action& action);
 void register_decode(CLI::App& app, Action& action);
 void register_lossless(CLI::App& app, Action& action);
 void register_feed(CLI::App& app, Action& action);
+void register_hw_report(CLI::App& app, Action& action);
+void register_vectors(CLI::App& app, Action& action);
 
 }  // namespace trm::cli

@@ -303,4 +303,49 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   return result;
 }
 
+CaptureDecodeResult decode_capture_stream(
+    const PipelineOptions& options, const std::string& capture_path,
+    const std::function<void(const link::ReceivedFrame& received, const DecodedFrame& decoded)>& sink) {
+  if (options.impl != "reference") {
+    throw std::invalid_argument("--capture is decoded by the reference decoder (it conceals lost lines); "
+                                "drop --impl " + options.impl);
+  }
+  link::CaptureReplay replay(capture_path);
+  nlohmann::json meta;
+  try {
+    meta = nlohmann::json::parse(replay.metadata());
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error("capture '" + capture_path + "' has no readable configuration in its header: " + e.what());
+  }
+  DecoderConfig config;
+  try {
+    config.link.reduction = meta.at("reduction").get<double>();
+    config.link.sigma = meta.at("sigma").get<double>();
+    config.link.phase = meta.at("phase").get<int>();
+    config.link.transfer = parse_transfer(meta.at("transfer").get<std::string>());
+    config.link.resample_space = parse_resample_space(meta.at("resample_space").get<std::string>());
+    config.link.bits = meta.at("bits").get<int>();
+    config.link.stereo = meta.at("stereo").get<bool>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error("capture '" + capture_path + "': incomplete configuration in its header: " + e.what());
+  }
+  config.sensitivity = options.sensitivity;
+  config.panel = parse_panel(options.panel);
+  config.output_bits = options.output_bits;
+  config.lcd_history = options.lcd_history;
+  ReferenceDecoder decoder(config);
+
+  CaptureDecodeResult result;
+  result.link_configuration = meta.dump();
+  while (auto received = replay.next_frame()) {
+    const DecodedFrame decoded = decoder.decode(LinkFrame{received->meta, received->codes}, received->line_intact);
+    result.concealed_lines += decoded.stats.concealed_lines;
+    ++result.views;
+    sink(*received, decoded);
+  }
+  if (result.views == 0) throw std::runtime_error("capture '" + capture_path + "' holds no frames");
+  result.receiver = replay.counters();
+  return result;
+}
+
 }  // namespace trm::cli

@@ -87,6 +87,19 @@ struct PipelineResult {
   std::optional<LinkOutcome> link;    // when the link was simulated
 };
 
+// A recorded packet stream (.trmcap) replayed through the receiver into the reference decoder. The link
+// configuration (r, sigma, transfer, bits, ...) comes from the capture's header; panel, sensitivity and output
+// bits from the options. Throws link::CaptureError / std::runtime_error with the file name on a bad capture.
+struct CaptureDecodeResult {
+  std::string link_configuration;   // the capture header's JSON
+  link::ReceiverCounters receiver;
+  std::int64_t views = 0;
+  std::int64_t concealed_lines = 0;
+};
+CaptureDecodeResult decode_capture_stream(
+    const PipelineOptions& options, const std::string& capture_path,
+    const std::function<void(const link::ReceivedFrame& received, const DecodedFrame& decoded)>& sink);
+
 // Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order.
 PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink);
 

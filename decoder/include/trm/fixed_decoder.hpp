@@ -18,6 +18,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -28,7 +29,7 @@ namespace trm {
 struct FixedDecoderConfig {
   // The algorithm parameters shared with ReferenceDecoder: link (r, sigma, transfer, bits; resample space must be
   // Encoded), motion sensitivity s, panel, output_bits (8 or 10), lcd_history. record_stages is ignored (no
-  // DecodeStages are filled).
+  // DecodeStages are filled; FixedFrameDecoder::decode(frame, taps) records the integer stages instead).
   DecoderConfig decoder;
 
   // Linear light I, L, alpha, shown beta, alpha': uQ1.F (the integer bit holds 1.0 exactly). beta = 2I - L is
@@ -108,10 +109,79 @@ struct FixedBufferReport {
   std::int64_t total_bits() const { return static_cast<std::int64_t>(lines) * samples * bits; }
 };
 
+// One ROM of the decoder (a lookup table or a direct table), `count` identical-shape copies (e.g. per channel).
+struct FixedRomReport {
+  std::string name;
+  int entries = 0;
+  int word_bits = 0;
+  int count = 1;
+  std::int64_t total_bits() const { return static_cast<std::int64_t>(count) * entries * word_bits; }
+};
+
+// Arithmetic of one stage, as the shared kernels (decoder/src/fixed_kernels.cpp) perform it: operators per
+// evaluation, and evaluations per frame of the given kind. Comparators include clamps and binary-search steps;
+// rounding additions (of the half LSB before a shift) are counted as adders.
+struct FixedArithmeticReport {
+  std::string stage;
+  std::string frame;          // "full", "reduced" or "both"
+  std::string evaluated_per;  // what one evaluation covers, e.g. "channel sample", "pixel"
+  std::int64_t evaluations = 0;  // per frame of that kind, at the reported size
+  int adders = 0;
+  int multipliers = 0;
+  int comparators = 0;
+  int rom_reads = 0;
+};
+
 struct FixedStreamingReport {
   int full_latency_lines = 0;     // full frame: input lines received before output line y is produced, minus y
   int reduced_latency_lines = 0;  // reduced frame: same in reduced input lines (output y needs reduced row i1(y))
-  std::vector<FixedBufferReport> buffers;
+  cv::Size full;                  // the view size reported on
+  cv::Size reduced;
+  std::vector<FixedBufferReport> buffers;  // names start with "line:" (on chip) or "frame:" (off chip)
+  std::vector<FixedRomReport> roms;
+  std::vector<FixedArithmeticReport> arithmetic;
+  // Frame stores against the paper's (Sec. 9: "one [buffer] for storing the previous frame and another one for the
+  // residual"): a full-size previous frame in link codes plus the full-size residual, at this configuration's
+  // formats; and this model's residual plus the reduced-size d_t (the LCD stores, needed by both, left out).
+  std::int64_t paper_frame_store_bits = 0;
+  std::int64_t model_frame_store_bits = 0;
+};
+
+// The integer planes of every stage of one decoded frame, for test vectors (FixedFrameDecoder::decode with taps).
+// Values are the raw integers of the stage's format, row-major with channels interleaved (R G B) where
+// channels == 3; motion contrast and weight are one value per pixel.
+enum class FixedStage {
+  Codes,           // received link codes (full size for full frames, reduced size for reduced frames)
+  Linear,          // full: I = lin(E_t)
+  Reduced,         // full: d_t = Q_b(D(E_t)) as the frame store holds it (exact-tie flag in bit b)
+  LowPass,         // full: L = lin(U(d_t))
+  Beta,            // full: beta = 2 I - L
+  Shown,           // full: clamp(beta, 0, 1)
+  Residual,        // full: rho (plus any LCD shortfall) in the residual store format
+  Alpha,           // reduced: alpha = lin(U(i))
+  PreviousLowPass, // reduced: L_{t-1} = lin(U(d_{t-1})) for the motion test (exact ties resolved)
+  Contrast,        // reduced: motion contrast c (per pixel)
+  Weight,          // reduced: w = exp(-s c) (per pixel)
+  AlphaPrime,      // reduced: alpha' = clamp(alpha + w rho, 0, 1) (clamp(alpha) without a residual)
+  Drive,           // drive codes (output_bits)
+};
+inline constexpr int kFixedStageCount = 13;
+
+struct FixedStagePlane {
+  bool present = false;
+  std::string name;      // short file-friendly name, e.g. "beta"
+  std::string format;    // e.g. "sQ3.24"
+  int bits = 0;          // word width including the sign bit
+  bool is_signed = false;
+  cv::Size size;
+  int channels = 3;
+  std::vector<std::int64_t> values;
+};
+
+struct FixedStageTaps {
+  std::array<FixedStagePlane, kFixedStageCount> planes;
+  FixedStagePlane& operator[](FixedStage s) { return planes[static_cast<std::size_t>(s)]; }
+  const FixedStagePlane& operator[](FixedStage s) const { return planes[static_cast<std::size_t>(s)]; }
 };
 
 namespace fixed_detail {
@@ -129,10 +199,13 @@ class FixedFrameDecoder {
   const FixedDecoderConfig& config() const;
   // As ReferenceDecoder::decode: one view, per-eye state; the doubles are the fixed values converted exactly.
   DecodedFrame decode(const LinkFrame& frame);
+  // The same, also filling taps with every stage's integer plane of this frame (the others are not present).
+  DecodedFrame decode(const LinkFrame& frame, FixedStageTaps& taps);
   const FixedStageCounts& last_counts() const;
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
+  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps);
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
@@ -146,7 +219,7 @@ class FixedStreamingDecoder {
   const FixedDecoderConfig& config() const;
   DecodedFrame decode(const LinkFrame& frame);
   const FixedStageCounts& last_counts() const;
-  // Latency and the line buffers / frame stores for a view of the given full size.
+  // Latency, line buffers / frame stores, ROMs and arithmetic per stage for a view of the given full size.
   FixedStreamingReport report(cv::Size full) const;
 
  private:

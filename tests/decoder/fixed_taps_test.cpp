@@ -1,0 +1,128 @@
+// The stage taps of the frame-at-a-time fixed-point decoder (the source of the golden vectors) and the hardware
+// report's ROMs, arithmetic and frame-store comparison.
+#include "trm/fixed_decoder.hpp"
+
+#include "decoder_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace trm {
+namespace {
+
+FixedDecoderConfig taps_config(const std::string& panel) {
+  FixedDecoderConfig config;
+  config.decoder.link.reduction = 0.5;
+  config.decoder.panel = parse_panel(panel);
+  return config;
+}
+
+std::int64_t raw_at(const cv::Mat& m, int y, int k, int frac_bits) {
+  return static_cast<std::int64_t>(std::ldexp(m.ptr<double>(y)[k], frac_bits));
+}
+
+// Moving content then a static pair: taps leave the output untouched and agree with it stage by stage.
+void check_sequence(const std::string& panel) {
+  const FixedDecoderConfig config = taps_config(panel);
+  const int F = config.linear_frac_bits;
+  FixedFrameDecoder tapped(config);
+  FixedStreamingDecoder plain(config);
+  const TrmEncoder encoder(config.decoder.link);
+  const int width = 21, height = 14;
+  std::vector<cv::Mat> images = {test::bright_square(width, height, 2, 3, 6), test::bright_square(width, height, 5, 4, 6),
+                                 test::random_image(width, height, 7), test::random_image(width, height, 7)};
+  for (std::size_t t = 0; t < images.size(); ++t) {
+    SCOPED_TRACE(panel + " frame " + std::to_string(t));
+    const LinkFrame frame = encoder.encode(images[t], static_cast<std::int64_t>(t), 0);
+    FixedStageTaps taps;
+    const DecodedFrame a = tapped.decode(frame, taps);
+    const DecodedFrame b = plain.decode(frame);
+    ASSERT_EQ(cv::norm(a.drive_codes, b.drive_codes, cv::NORM_INF), 0.0);
+    const bool full = frame.meta.parity == Parity::Full;
+    const FixedStagePlane& drive = taps[FixedStage::Drive];
+    const FixedStagePlane& codes = taps[FixedStage::Codes];
+    ASSERT_TRUE(drive.present && codes.present);
+    EXPECT_EQ(codes.size, frame.codes.size());
+    for (int y = 0; y < height; ++y) {
+      for (int k = 0; k < 3 * width; ++k) {
+        const std::size_t i = static_cast<std::size_t>(y * 3 * width + k);
+        ASSERT_EQ(drive.values[i], a.drive_codes.ptr<std::uint16_t>(y)[k]);
+        const std::int64_t wanted = raw_at(a.wanted_linear, y, k, F);
+        if (full) {
+          const auto& beta = taps[FixedStage::Beta].values;
+          const auto& shown = taps[FixedStage::Shown].values;
+          const auto& rho = taps[FixedStage::Residual].values;
+          const auto& I = taps[FixedStage::Linear].values;
+          const auto& L = taps[FixedStage::LowPass].values;
+          ASSERT_EQ(beta[i], 2 * I[i] - L[i]);
+          ASSERT_EQ(shown[i], std::clamp<std::int64_t>(beta[i], 0, std::int64_t{1} << F));
+          ASSERT_EQ(shown[i], wanted);
+          if (panel != "lcd") {
+            ASSERT_EQ(rho[i], beta[i] - shown[i]);  // sQ2.F holds rho exactly
+          }
+        } else {
+          ASSERT_EQ(taps[FixedStage::AlphaPrime].values[i], wanted);
+        }
+      }
+    }
+    if (!full) {
+      ASSERT_TRUE(taps[FixedStage::Weight].present);
+      const auto& c = taps[FixedStage::Contrast].values;
+      const auto& w = taps[FixedStage::Weight].values;
+      if (t == 3) {  // static pair: nothing moved, c = 0 and w = 1 everywhere
+        EXPECT_EQ(*std::max_element(c.begin(), c.end()), 0);
+        EXPECT_EQ(*std::min_element(w.begin(), w.end()), std::int64_t{1} << F);
+      } else {
+        EXPECT_GT(*std::max_element(c.begin(), c.end()), 0);
+        EXPECT_LT(*std::min_element(w.begin(), w.end()), std::int64_t{1} << F);
+      }
+    }
+  }
+}
+
+TEST(FixedTaps, StagesAgreeWithTheOutputOled) { check_sequence("vive"); }
+TEST(FixedTaps, StagesAgreeWithTheOutputLcd) { check_sequence("lcd"); }
+
+TEST(FixedTaps, ReducedFrameWithoutResidualHasNoMotionStages) {
+  FixedFrameDecoder decoder(taps_config("vive"));
+  EncoderConfig link;
+  link.reduction = 0.5;
+  link.phase = 1;  // frame 0 is reduced
+  const TrmEncoder encoder(link);
+  FixedStageTaps taps;
+  decoder.decode(encoder.encode(test::random_image(9, 7, 3), 0, 0), taps);
+  EXPECT_TRUE(taps[FixedStage::Alpha].present);
+  EXPECT_TRUE(taps[FixedStage::AlphaPrime].present);
+  EXPECT_FALSE(taps[FixedStage::Contrast].present);
+  EXPECT_FALSE(taps[FixedStage::Weight].present);
+  EXPECT_FALSE(taps[FixedStage::Beta].present);
+}
+
+TEST(FixedHardwareReport, RomsArithmeticAndFrameStores) {
+  for (const char* panel : {"vive", "lcd"}) {
+    SCOPED_TRACE(panel);
+    const FixedStreamingDecoder decoder(taps_config(panel));
+    const FixedStreamingReport r = decoder.report(cv::Size(1080, 1200));
+    EXPECT_EQ(r.reduced, cv::Size(540, 600));
+    ASSERT_FALSE(r.roms.empty());
+    for (const auto& rom : r.roms) EXPECT_GT(rom.total_bits(), 0) << rom.name;
+    const bool has_lcd_rom = std::any_of(r.roms.begin(), r.roms.end(), [](const FixedRomReport& rom) {
+      return rom.name.rfind("LCD", 0) == 0;
+    });
+    EXPECT_EQ(has_lcd_rom, std::string(panel) == "lcd");
+    ASSERT_FALSE(r.arithmetic.empty());
+    for (const auto& a : r.arithmetic) EXPECT_GT(a.evaluations, 0) << a.stage;
+    // Paper: full previous frame (8 bits) + residual; here: reduced d_t (9 bits) + residual.
+    const std::int64_t full = 3LL * 1080 * 1200;
+    const std::int64_t reduced = 3LL * 540 * 600;
+    EXPECT_EQ(r.paper_frame_store_bits, full * 8 + full * 26);
+    EXPECT_EQ(r.model_frame_store_bits, reduced * 9 + full * 26);
+  }
+}
+
+}  // namespace
+}  // namespace trm

@@ -1,0 +1,143 @@
+// The checked-in golden vectors (tests/golden/vectors.txt): every stage file of `trm vectors` for a few small
+// scenes, as 64-bit FNV-1a hashes. Any change of the fixed-point decoder's bits must be deliberate.
+#include "vectors.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <map>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TrmRun {
+  int exit_code = -1;
+  std::string output;
+};
+
+TrmRun trm(const std::string& args) {
+  TrmRun r;
+  FILE* pipe = popen((std::string(TRM_EXECUTABLE) + " " + args + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buffer{};
+  while (fgets(buffer.data(), static_cast<int>(buffer.size()), pipe)) r.output += buffer.data();
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+fs::path scratch() {
+  std::random_device rd;
+  const fs::path p = fs::temp_directory_path() / ("trm-hw-" + std::to_string(rd()));
+  fs::create_directories(p);
+  return p;
+}
+
+// "<scene> <panel> <file>" -> hash, comment lines skipped.
+std::map<std::string, std::string> parse(const std::string& text) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto last = line.rfind(' ');
+    out[line.substr(0, last)] = line.substr(last + 1);
+  }
+  return out;
+}
+
+TEST(GoldenVectors, FixedDecoderStagesMatchTheCheckedInHashes) {
+  const std::string path = std::string(TRM_SOURCE_DIR) + "/tests/golden/vectors.txt";
+  std::ifstream file(path);
+  ASSERT_TRUE(file) << "missing " << path << "; create it with: trm vectors --update-golden tests/golden/vectors.txt";
+  std::stringstream stored;
+  stored << file.rdbuf();
+  const auto expected = parse(stored.str());
+  const auto actual = parse(trm::cli::golden_vectors_text());
+  const std::string update = "if the change is deliberate, update with: trm vectors --update-golden tests/golden/vectors.txt";
+  int differences = 0;
+  for (const auto& [key, hash] : actual) {
+    const auto found = expected.find(key);
+    if (found == expected.end()) {
+      ADD_FAILURE() << "new stage file (scene panel file): " << key;
+      ++differences;
+    } else if (found->second != hash) {
+      ADD_FAILURE() << "changed (scene panel file): " << key << ": expected " << found->second << ", got " << hash;
+      ++differences;
+    }
+  }
+  for (const auto& [key, hash] : expected) {
+    if (actual.find(key) == actual.end()) {
+      ADD_FAILURE() << "stage file no longer produced (scene panel file): " << key;
+      ++differences;
+    }
+  }
+  EXPECT_EQ(differences, 0) << update;
+  EXPECT_GT(actual.size(), 100u);
+}
+
+TEST(HwReport, WritesJsonWithTotalsAndThePaperComparison) {
+  const fs::path dir = scratch();
+  const TrmRun r = trm("hw-report --size 64x48 --panel lcd --residual-bits 18 --json " + (dir / "hw.json").string() +
+                    " --out " + (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("paper's previous frame + residual"), std::string::npos) << r.output;
+  std::ifstream in(dir / "hw.json");
+  const auto report = nlohmann::json::parse(in);
+  const auto& hw = report["hardware"];
+  EXPECT_EQ(report["parameters"]["residual_format"].get<std::string>().rfind("sQ2.16", 0), 0u);
+  const auto& totals = hw["totals"];
+  EXPECT_EQ(totals["on_chip_bits"].get<std::int64_t>(),
+            totals["line_buffer_bits"].get<std::int64_t>() + totals["rom_bits"].get<std::int64_t>());
+  EXPECT_GT(hw["paper_comparison"]["saved_bits"].get<std::int64_t>(), 0);
+  EXPECT_FALSE(hw["roms"].empty());
+  EXPECT_FALSE(hw["arithmetic"].empty());
+  EXPECT_TRUE(fs::exists(dir / "out" / "report.json"));
+  fs::remove_all(dir);
+}
+
+TEST(HwReport, BadInputFailsWithoutOutput) {
+  const fs::path dir = scratch();
+  for (const std::string& args : {std::string("hw-report --residual-bits 2"), std::string("hw-report --residual-bits 40"),
+                                  std::string("hw-report --size 0x4"), std::string("vectors --scene nope"),
+                                  std::string("vectors --scene discs --size 3"),
+                                  std::string("vectors --scene discs --frames 0")}) {
+    const TrmRun r = trm(args + " --out " + (dir / "out").string());
+    EXPECT_NE(r.exit_code, 0) << args << "\n" << r.output;
+    EXPECT_FALSE(r.output.empty()) << args;
+    EXPECT_FALSE(fs::exists(dir / "out")) << args;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Vectors, WritesOneHexFilePerStageAndAReadme) {
+  const fs::path dir = scratch();
+  const TrmRun r = trm("vectors --scene checker --frames 2 --size 10x6 --panel lcd --out " + (dir / "v").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream readme(dir / "v" / "README.md");
+  std::stringstream text;
+  text << readme.rdbuf();
+  EXPECT_NE(text.str().find("sQ3.24"), std::string::npos);  // beta, from the configuration
+  std::ifstream beta(dir / "v" / "frame_000_full_beta.hex");
+  std::string line;
+  int lines = 0;
+  while (std::getline(beta, line)) {
+    ++lines;
+    EXPECT_EQ(line.size(), 10u * 3u * 8u - 1u);  // 30 words of 7 hex digits, one space between
+  }
+  EXPECT_EQ(lines, 6);
+  EXPECT_TRUE(fs::exists(dir / "v" / "frame_001_reduced_w.hex"));
+  fs::remove_all(dir);
+}
+
+}  // namespace

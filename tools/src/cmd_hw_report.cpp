@@ -1,0 +1,57 @@
+// `trm hw-report`: the decoder as hardware for one configuration and view size: line buffers, frame stores, ROMs,
+// arithmetic per stage, latency, on-/off-chip totals and the paper's frame-store comparison (DESIGN §5).
+#include "commands.hpp"
+#include "hw_report.hpp"
+#include "output_dir.hpp"
+
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+namespace trm::cli {
+
+void register_hw_report(CLI::App& app, Action& action) {
+  auto options = std::make_shared<PipelineOptions>();
+  auto residual_bits = std::make_shared<int>(26);
+  auto out = std::make_shared<std::string>();
+  auto json = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "hw-report", "Report the fixed-point decoder as hardware: line buffers, frame stores, ROMs, arithmetic per "
+                   "stage, latency and memory totals (default 1080x1200, r = 1/2, vive OLED)");
+  options->add_options(*cmd);
+  cmd->add_option("--residual-bits", *residual_bits, "Residual store width N (signed sQ2.(N-2))")->capture_default_str();
+  cmd->add_option("--out,-o", *out, "Also write DIR/report.json (directory written whole or not at all)");
+  cmd->add_option("--json", *json, "Also write the JSON to FILE");
+  cmd->callback([options, residual_bits, out, json, &action] {
+    action = [options, residual_bits, out, json] {
+      options->validate();
+      FixedDecoderConfig config = fixed_config_of(*options);
+      config.residual = residual_format_of_bits(*residual_bits, config.linear_frac_bits);
+      const FixedStreamingDecoder decoder(config);  // validates the configuration
+      Json report;
+      report["parameters"] = {{"size", {options->width, options->height}},
+                              {"reduction", options->encoder.reduction},
+                              {"sigma", options->encoder.effective_sigma()},
+                              {"panel", options->panel},
+                              {"link_bits", options->encoder.bits},
+                              {"output_bits", options->output_bits},
+                              {"residual_format", config.residual.to_string()},
+                              {"linear_frac_bits", config.linear_frac_bits}};
+      report["hardware"] = hardware_json(decoder.report(cv::Size(options->width, options->height)));
+      const std::string text = report.dump(2) + "\n";
+      if (!out->empty()) {
+        OutputDir dir(*out);
+        dir.write_text("report.json", text);
+        dir.commit();
+      }
+      if (!json->empty()) write_file_atomically(*json, text);
+      std::cout << "trm hw-report: " << options->panel << ", r = " << options->encoder.reduction << ", "
+                << options->encoder.bits << "-bit link, " << options->output_bits << "-bit drive, residual "
+                << config.residual.to_string() << "\n"
+                << hardware_summary(report["hardware"]);
+      return 0;
+    };
+  });
+}
+
+}  // namespace trm::cli
