@@ -12,21 +12,18 @@ namespace trm::cli {
 
 void register_hw_report(CLI::App& app, Action& action) {
   auto options = std::make_shared<PipelineOptions>();
-  auto residual_bits = std::make_shared<int>(26);
   auto out = std::make_shared<std::string>();
   auto json = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
       "hw-report", "Report the fixed-point decoder as hardware: line buffers, frame stores, ROMs, arithmetic per "
                    "stage, latency and memory totals (default 1080x1200, r = 1/2, vive OLED)");
   options->add_options(*cmd);
-  cmd->add_option("--residual-bits", *residual_bits, "Residual store width N (signed sQ2.(N-2))")->capture_default_str();
   cmd->add_option("--out,-o", *out, "Also write DIR/report.json (directory written whole or not at all)");
   cmd->add_option("--json", *json, "Also write the JSON to FILE");
-  cmd->callback([options, residual_bits, out, json, &action] {
-    action = [options, residual_bits, out, json] {
+  cmd->callback([options, out, json, &action] {
+    action = [options, out, json] {
       options->validate();
       FixedDecoderConfig config = fixed_config_of(*options);
-      config.residual = residual_format_of_bits(*residual_bits, config.linear_frac_bits);
       const FixedStreamingDecoder decoder(config);  // validates the configuration
       Json report;
       report["parameters"] = {{"size", {options->width, options->height}},

@@ -1,5 +1,7 @@
 #include "pipeline.hpp"
 
+#include "hw_report.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -97,6 +99,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
       "LCD: build each pair target on the previous wanted value (wanted, the design's rule) or on what the "
       "previous frame actually contributed (contributed)");
   cmd.add_option("--seed", seed, "Seed for scenes with randomness")->capture_default_str();
+  cmd.add_option("--residual-bits", residual_bits,
+                 "Fixed-point residual store width N, signed sQ2.(N-2) (default: 26, lossless)");
   cmd.add_option("--impl", impl,
                  "Decoder: reference (double), fixed (fixed-point, line-buffered streaming: the hardware model) or "
                  "fixed-frame (the same arithmetic frame at a time)")
@@ -211,8 +215,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   decoder_config.output_bits = options.output_bits;
   decoder_config.lcd_history = options.lcd_history;
   ReferenceDecoder decoder(decoder_config);
-  FixedDecoderConfig fixed_config;
-  fixed_config.decoder = decoder_config;
+  const FixedDecoderConfig fixed_config = fixed_config_of(options);
   std::optional<FixedStreamingDecoder> streaming;
   std::optional<FixedFrameDecoder> frame_at_a_time;
   if (options.impl == "fixed") streaming.emplace(fixed_config);
@@ -236,7 +239,9 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   std::vector<LinkFrame> sent(static_cast<std::size_t>(eyes));
   std::vector<double> encode_seconds(static_cast<std::size_t>(eyes));
   for (std::int64_t t = 0; t < frames; ++t) {
+    const auto render_start = std::chrono::steady_clock::now();
     const cv::Mat linear = source->linear_frame(t);
+    const double render_seconds = seconds_since(render_start);
     for (int eye = 0; eye < eyes; ++eye) {
       const auto start = std::chrono::steady_clock::now();
       sent[static_cast<std::size_t>(eye)] = encoder.encode(linear, t, eye);
@@ -285,6 +290,8 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       view.sent = &view_sent;
       view.decoded = &decoded;
       if (compare) view.reference = &reference;
+      if (fixed) view.fixed_counts = streaming ? &streaming->last_counts() : &frame_at_a_time->last_counts();
+      view.render_seconds = render_seconds;
       view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];
       view.decode_seconds = decode_seconds >= 0.0 ? decode_seconds : seconds_since(start);
       sink(view);

@@ -32,6 +32,7 @@ struct PipelineOptions {
   int output_bits = 8;
   std::string impl = "reference";     // reference | fixed (streaming, the hardware model) | fixed-frame
   bool compare_reference = false;     // with a fixed impl: also run the reference and compare codes
+  int residual_bits = 0;              // fixed impl: residual store width N (sQ2.(N-2)); 0 = the default
   LcdHistory lcd_history = LcdHistory::Wanted;
 
   // Simulated display link (off when link_preset is empty and no fault or capture is asked for).
@@ -67,6 +68,8 @@ struct DecodedView {
   const LinkFrame* sent = nullptr;        // what crossed the link
   const DecodedFrame* decoded = nullptr;  // what the decoder produced
   const DecodedFrame* reference = nullptr;  // the reference decoder's output, when compared beside a fixed impl
+  const FixedStageCounts* fixed_counts = nullptr;  // fixed impl: saturation / clip events of this view per stage
+  double render_seconds = 0.0;            // producing the source frame (shared by the eyes of a link frame)
   double encode_seconds = 0.0;
   double decode_seconds = 0.0;
 };

@@ -102,6 +102,19 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     rec["dropped_sum"] = d.stats.dropped_sum;
   }
   if (panel_.kind == PanelKind::Lcd) rec["lcd_unreachable_fraction"] = d.stats.lcd_unreachable_fraction;
+  if (view.fixed_counts) {
+    const FixedStageCounts& c = *view.fixed_counts;
+    rec["fixed_point_events"] = {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
+                                 {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
+                                 {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+    fixed_totals_.beta_clipped += c.beta_clipped;
+    fixed_totals_.residual_saturated += c.residual_saturated;
+    fixed_totals_.residual_rounded += c.residual_rounded;
+    fixed_totals_.alpha_clipped += c.alpha_clipped;
+    fixed_totals_.weight_underflow += c.weight_underflow;
+    fixed_totals_.lcd_unreachable += c.lcd_unreachable;
+    have_fixed_counts_ = true;
+  }
   if (view.reference) {
     cv::Mat difference;
     cv::absdiff(d.drive_codes, view.reference->drive_codes, difference);
@@ -115,7 +128,8 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     rec["vs_reference"] = {{"identical_fraction", static_cast<double>(identical) / static_cast<double>(samples)},
                            {"max_lsb", max_difference}};
   }
-  rec["seconds"] = {{"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
+  rec["seconds"] = {{"render", view.render_seconds}, {"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
+  sum_render_ += view.render_seconds;
   frames_.push_back(std::move(rec));
 
   const cv::Mat reference = full_rate_emission(*view.linear_full, panel_, options_.output_bits);
@@ -186,7 +200,15 @@ Json RunRecorder::report(double wall_seconds) const {
                          {"identical_fraction", static_cast<double>(identical_codes_) / static_cast<double>(compared_codes_)},
                          {"max_lsb", max_code_difference_}};
   }
-  s["mean_seconds"] = {{"encode", n > 0 ? sum_encode_ / n : 0.0}, {"decode", n > 0 ? sum_decode_ / n : 0.0}};
+  if (have_fixed_counts_) {
+    const FixedStageCounts& c = fixed_totals_;
+    s["fixed_point_events"] = {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
+                               {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
+                               {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+  }
+  s["mean_seconds"] = {{"render", n > 0 ? sum_render_ / n : 0.0},
+                       {"encode", n > 0 ? sum_encode_ / n : 0.0},
+                       {"decode", n > 0 ? sum_decode_ / n : 0.0}};
   s["wall_seconds"] = wall_seconds;
   r["summary"] = s;
   r["pairs"] = pairs_;
@@ -226,6 +248,9 @@ std::string RunRecorder::summary_table() const {
         fmt("%.4f %% of codes identical", 100.0 * static_cast<double>(identical_codes_) /
                                                static_cast<double>(compared_codes_)) +
             fmt(", max %.0f LSB", max_code_difference_));
+  }
+  if (have_fixed_counts_ && fixed_totals_.residual_saturated > 0) {
+    row("residual store saturations", std::to_string(fixed_totals_.residual_saturated) + " samples");
   }
   row("encode / decode per view", fmt("%.1f ms", 1e3 * s["mean_seconds"]["encode"].get<double>()) + " / " +
                                       fmt("%.1f ms", 1e3 * s["mean_seconds"]["decode"].get<double>()));

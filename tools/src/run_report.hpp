@@ -56,6 +56,9 @@ class RunRecorder {
   // Fixed-point decoder against the reference beside it: output codes compared.
   std::int64_t compared_codes_ = 0, identical_codes_ = 0;
   double max_code_difference_ = 0.0;
+  FixedStageCounts fixed_totals_;
+  bool have_fixed_counts_ = false;
+  double sum_render_ = 0;
 };
 
 // Rough PSNR (dB) between two linear images, measured on their sRGB encodings scaled to [0, 1];
