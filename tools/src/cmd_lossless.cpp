@@ -3,6 +3,7 @@
 // result is coded bits per displayed pixel, next to full-rate coding of the same frames.
 #include "commands.hpp"
 #include "output_dir.hpp"
+#include "pipeline.hpp"
 
 #include "trm/encoder.hpp"
 #include "trm/jpegls.hpp"
@@ -60,14 +61,10 @@ void register_lossless(CLI::App& app, Action& action) {
   cmd->add_option("--reduction,-r", o->reductions, "Reductions r to measure")->capture_default_str();
   cmd->add_option_function<std::string>(
       "--size",
-      [o](const std::string& s) {
-        int w = 0, h = 0;
-        char x = 0, extra = 0;
-        if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1) {
-          throw CLI::ValidationError("--size", "expected WxH with W, H >= 1, got '" + s + "'");
-        }
-        o->width = w;
-        o->height = h;
+      [o](const std::string& text) {
+        const cv::Size size = parse_view_size(text);
+        o->width = size.width;
+        o->height = size.height;
       },
       "View size WxH (default 540x600)");
   cmd->add_option("--frames", o->frames, "Frames per scene")->capture_default_str();

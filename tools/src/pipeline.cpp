@@ -42,6 +42,26 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+cv::Size parse_view_size(const std::string& text, const std::string& option) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1) {
+    throw CLI::ValidationError(option, "expected WxH with W, H >= 1, got '" + text + "'");
+  }
+  return {w, h};
+}
+
+std::unique_ptr<FrameSource> PipelineOptions::open_source() const {
+  if (!input.empty()) return looks_like_image_sequence(input) ? open_image_sequence(input) : open_video(input);
+  SceneParams params;
+  params.width = width;
+  params.height = height;
+  params.refresh_hz = refresh_hz;
+  params.seed = seed;
+  params.image_path = image;
+  return make_scene(scene, params);
+}
+
 void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter)")
       ->capture_default_str();
@@ -51,15 +71,10 @@ void PipelineOptions::add_options(CLI::App& cmd) {
                                          std::to_string(default_frames) + " for a scene)");
   cmd.add_option_function<std::string>(
          "--size",
-         [this](const std::string& s) {
-           int w = 0, h = 0;
-           char x = 0, extra = 0;
-           if (std::sscanf(s.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 ||
-               h < 1) {
-             throw CLI::ValidationError("--size", "expected WxH with W, H >= 1, got '" + s + "'");
-           }
-           width = w;
-           height = h;
+         [this](const std::string& text) {
+           const cv::Size size = parse_view_size(text);
+           width = size.width;
+           height = size.height;
          },
          "View size WxH for built-in scenes (default 1080x1200, one eye of a Vive-class headset)");
   cmd.add_option("--refresh", refresh_hz, "Panel refresh rate in Hz")->capture_default_str();
@@ -181,18 +196,7 @@ void PipelineOptions::validate() const {
 
 PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink) {
   options.validate();
-  std::unique_ptr<FrameSource> source;
-  if (!options.input.empty()) {
-    source = looks_like_image_sequence(options.input) ? open_image_sequence(options.input) : open_video(options.input);
-  } else {
-    SceneParams params;
-    params.width = options.width;
-    params.height = options.height;
-    params.refresh_hz = options.refresh_hz;
-    params.seed = options.seed;
-    params.image_path = options.image;
-    source = make_scene(options.scene, params);
-  }
+  const std::unique_ptr<FrameSource> source = options.open_source();
 
   std::int64_t frames = options.frames;
   const auto available = source->frame_count();

@@ -59,6 +59,8 @@ struct PipelineOptions {
   void add_options(CLI::App& cmd);
   // Validates everything up front (throws std::invalid_argument with one clear message).
   void validate() const;
+  // The frame source these options name: the --input sequence or video, else the built-in scene.
+  std::unique_ptr<FrameSource> open_source() const;
 };
 
 // One decoded view, as the pipeline hands it to a sink.
@@ -73,6 +75,9 @@ struct DecodedView {
   double encode_seconds = 0.0;
   double decode_seconds = 0.0;
 };
+
+// "WxH" with W, H >= 1; throws CLI::ValidationError naming `option` otherwise.
+cv::Size parse_view_size(const std::string& text, const std::string& option = "--size");
 
 struct LinkOutcome {
   std::vector<link::LinkFrameUsage> frames;

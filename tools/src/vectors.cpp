@@ -94,13 +94,7 @@ VectorSet generate_vectors(const PipelineOptions& options_in) {
   if (options.frames < 0) throw std::invalid_argument("--frames must be >= 1");
   if (options.frames == 0) options.frames = 4;
   options.validate();
-  SceneParams params;
-  params.width = options.width;
-  params.height = options.height;
-  params.refresh_hz = options.refresh_hz;
-  params.seed = options.seed;
-  params.image_path = options.image;
-  std::unique_ptr<FrameSource> source = make_scene(options.scene, params);
+  std::unique_ptr<FrameSource> source = options.open_source();
   const FixedDecoderConfig config = fixed_config_of(options);
   FixedFrameDecoder decoder(config);
   TrmEncoder encoder(options.encoder);
