@@ -4,6 +4,7 @@
 // driveB_NNNN.png (the B-bit drive codes; 10-bit codes are stored in a 16-bit PNG).
 #include "commands.hpp"
 #include "output_dir.hpp"
+#include "link_report.hpp"
 #include "pipeline.hpp"
 #include "run_report.hpp"
 
@@ -45,19 +46,23 @@ cv::Mat drive_16bit(const cv::Mat& drive) {
 // `trm decode --capture`: replays a recorded packet stream through the receiver into the decoder. The link
 // configuration (r, sigma, transfer, bits, ...) comes from the capture's header; panel, sensitivity and output
 // bits from the command line.
+// Writes frame t's drive_tttt.png (16-bit round(v * 65535)) and driveB_tttt.png (the B-bit codes; 8-bit codes as
+// an 8-bit PNG); the right eye of a stereo stream gets a "_right" suffix.
+void write_drive_files(const OutputDir& dir, const FrameMeta& meta, const DecodedFrame& decoded, int output_bits) {
+  const std::string eye = meta.eye == 0 ? "" : "_right";
+  dir.write_png(numbered("drive" + eye, meta.index), drive_16bit(decoded.drive));
+  cv::Mat codes = decoded.drive_codes;
+  if (output_bits == 8) codes.convertTo(codes, CV_8U);
+  dir.write_png(numbered("drive" + std::to_string(output_bits) + eye, meta.index), codes);
+}
+
 int decode_capture(const PipelineOptions& options, const std::string& capture_path, const std::string& out) {
   OutputDir dir(out);
-  const std::string code_prefix = "drive" + std::to_string(options.output_bits);
   Json frames = Json::array();
   const CaptureDecodeResult result =
       decode_capture_stream(options, capture_path, [&](const link::ReceivedFrame& received, const DecodedFrame& decoded) {
-        const std::int64_t t = received.meta.index;
-        const std::string eye = received.meta.eye == 0 ? "" : "_right";
-        dir.write_png(numbered("drive" + eye, t), drive_16bit(decoded.drive));
-        cv::Mat codes = decoded.drive_codes;
-        if (options.output_bits == 8) codes.convertTo(codes, CV_8U);
-        dir.write_png(numbered(code_prefix + eye, t), codes);
-        frames.push_back({{"t", t},
+        write_drive_files(dir, received.meta, decoded, options.output_bits);
+        frames.push_back({{"t", received.meta.index},
                           {"eye", received.meta.eye},
                           {"parity", to_string(received.meta.parity)},
                           {"intact_lines", received.intact_lines()},
@@ -72,10 +77,7 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
   report["parameters"] = {{"sensitivity", options.sensitivity},
                           {"panel", options.panel},
                           {"output_bits", options.output_bits}};
-  report["receiver"] = {{"packets_received", c.packets_received}, {"packets_accepted", c.packets_accepted},
-                        {"crc_failures", c.crc_failures},         {"malformed", c.malformed},
-                        {"inconsistent", c.inconsistent},         {"duplicates", c.duplicates},
-                        {"stale", c.stale}};
+  report["receiver"] = receiver_json(c);
   report["summary"] = {{"views", result.views}, {"concealed_lines", result.concealed_lines}};
   report["frames"] = frames;
   dir.write_text("report.json", report.dump(2) + "\n");
@@ -112,15 +114,9 @@ void register_decode(CLI::App& app, Action& action) {
       const auto start = std::chrono::steady_clock::now();
       OutputDir dir(*out);
       RunRecorder recorder(*options);
-      const std::string code_prefix = "drive" + std::to_string(options->output_bits);
       const std::int64_t frames = run_pipeline(*options, [&](const DecodedView& view) {
         recorder.add(view);
-        const std::int64_t t = view.sent->meta.index;
-        const std::string eye = view.sent->meta.eye == 0 ? "" : "_right";
-        dir.write_png(numbered("drive" + eye, t), drive_16bit(view.decoded->drive));
-        cv::Mat codes = view.decoded->drive_codes;
-        if (options->output_bits == 8) codes.convertTo(codes, CV_8U);  // 8-bit codes as an 8-bit PNG
-        dir.write_png(numbered(code_prefix + eye, t), codes);
+        write_drive_files(dir, view.sent->meta, *view.decoded, options->output_bits);
       }).frames;
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       dir.write_text("report.json", recorder.report(wall).dump(2) + "\n");

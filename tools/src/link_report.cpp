@@ -83,16 +83,17 @@ Json write_link_outputs(const OutputDir& dir, const PipelineOptions& options, co
                  {"random_bit_errors", outcome.faults.random_bit_errors},
                  {"bursts", outcome.faults.bursts},
                  {"burst_bit_errors", outcome.faults.burst_bit_errors}};
-  j["receiver"] = {{"packets_received", outcome.receiver.packets_received},
-                   {"packets_accepted", outcome.receiver.packets_accepted},
-                   {"crc_failures", outcome.receiver.crc_failures},
-                   {"malformed", outcome.receiver.malformed},
-                   {"inconsistent", outcome.receiver.inconsistent},
-                   {"duplicates", outcome.receiver.duplicates},
-                   {"stale", outcome.receiver.stale}};
+  j["receiver"] = receiver_json(outcome.receiver);
   j["concealed_lines"] = outcome.concealed_lines;
   j["lost_views"] = outcome.lost_views;
   return j;
+}
+
+Json receiver_json(const link::ReceiverCounters& c) {
+  return {{"packets_received", c.packets_received}, {"packets_accepted", c.packets_accepted},
+          {"crc_failures", c.crc_failures},         {"malformed", c.malformed},
+          {"inconsistent", c.inconsistent},         {"duplicates", c.duplicates},
+          {"stale", c.stale}};
 }
 
 std::string link_summary_lines(const LinkOutcome& outcome) {

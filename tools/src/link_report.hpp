@@ -14,5 +14,7 @@ namespace trm::cli {
 Json write_link_outputs(const OutputDir& dir, const PipelineOptions& options, const LinkOutcome& outcome,
                         int full_width, int full_height);
 std::string link_summary_lines(const LinkOutcome& outcome);
+// The receiver's counters as report.json holds them (run --link and decode --capture).
+Json receiver_json(const link::ReceiverCounters& counters);
 
 }  // namespace trm::cli

@@ -39,6 +39,13 @@ cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output
   return out;
 }
 
+// Saturation / clip events of the fixed-point decoder, per stage.
+Json events_json(const FixedStageCounts& c) {
+  return {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
+          {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
+          {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+}
+
 Json json_number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 }  // namespace
@@ -104,9 +111,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   if (panel_.kind == PanelKind::Lcd) rec["lcd_unreachable_fraction"] = d.stats.lcd_unreachable_fraction;
   if (view.fixed_counts) {
     const FixedStageCounts& c = *view.fixed_counts;
-    rec["fixed_point_events"] = {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
-                                 {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
-                                 {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+    rec["fixed_point_events"] = events_json(c);
     fixed_totals_.beta_clipped += c.beta_clipped;
     fixed_totals_.residual_saturated += c.residual_saturated;
     fixed_totals_.residual_rounded += c.residual_rounded;
@@ -201,10 +206,7 @@ Json RunRecorder::report(double wall_seconds) const {
                          {"max_lsb", max_code_difference_}};
   }
   if (have_fixed_counts_) {
-    const FixedStageCounts& c = fixed_totals_;
-    s["fixed_point_events"] = {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
-                               {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
-                               {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+    s["fixed_point_events"] = events_json(fixed_totals_);
   }
   s["mean_seconds"] = {{"render", n > 0 ? sum_render_ / n : 0.0},
                        {"encode", n > 0 ? sum_encode_ / n : 0.0},
