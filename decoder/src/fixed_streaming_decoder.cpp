@@ -153,9 +153,17 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
   r.paper_frame_store_bits = full_samples * b + full_samples * c.residual.width();
   r.model_frame_store_bits = reduced_samples * (b + 1) + full_samples * c.residual.width();
   if (c.decoder.panel.kind == PanelKind::Lcd) {
-    r.buffers.push_back({"frame: LCD v_{t-1} (drive codes)", g.full.height, 3 * g.full.width, c.decoder.output_bits});
-    r.buffers.push_back({"frame: LCD x_{t-1} (sQ3." + std::to_string(c.linear_frac_bits) + ")", g.full.height,
-                         3 * g.full.width, 3 + c.linear_frac_bits});
+    // Appended by name and fields (a braced temporary from a literal trips GCC 12's false -Warray-bounds).
+    FixedBufferReport& drive_store = r.buffers.emplace_back();
+    drive_store.name = std::string("frame: LCD v_{t-1} (drive codes)");
+    drive_store.lines = g.full.height;
+    drive_store.samples = 3 * g.full.width;
+    drive_store.bits = c.decoder.output_bits;
+    FixedBufferReport& wanted_store = r.buffers.emplace_back();
+    wanted_store.name = std::string("frame: LCD x_{t-1} (sQ3.").append(std::to_string(c.linear_frac_bits)).append(")");
+    wanted_store.lines = g.full.height;
+    wanted_store.samples = 3 * g.full.width;
+    wanted_store.bits = 3 + c.linear_frac_bits;
   }
   return r;
 }

@@ -530,6 +530,28 @@ DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame, std::span<const st
 
 DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) { return decode_view(frame, {}); }
 
+void ReferenceDecoder::adopt_panel_history(const DecodedFrame& shown) {
+  if (config_.panel.kind != PanelKind::Lcd) {
+    throw std::invalid_argument("ReferenceDecoder: adopt_panel_history is for LCD panels (an OLED has no history)");
+  }
+  const auto found = eyes_.find(shown.meta.eye);
+  if (found == eyes_.end() || found->second.previous_drive.empty()) {
+    throw std::invalid_argument("ReferenceDecoder: eye " + std::to_string(shown.meta.eye) +
+                                " has no LCD history to replace (decode a frame of it first)");
+  }
+  EyeState& eye = found->second;
+  if (shown.drive_codes.size() != eye.previous_drive.size() || shown.drive_codes.type() != CV_16UC3) {
+    throw std::invalid_argument("ReferenceDecoder: adopt_panel_history needs the eye's view size in CV_16UC3 codes");
+  }
+  double max_code = 0.0;
+  cv::minMaxLoc(shown.drive_codes.reshape(1), nullptr, &max_code);
+  if (max_code > (1 << config_.output_bits) - 1) {
+    throw std::invalid_argument("ReferenceDecoder: adopted drive codes exceed " + std::to_string(config_.output_bits) +
+                                " bits");
+  }
+  eye.previous_drive = dequantise(shown.drive_codes, config_.output_bits);
+}
+
 DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
   check_link_frame(frame, config_);
   const FrameMeta& meta = frame.meta;

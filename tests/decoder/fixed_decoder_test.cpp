@@ -150,13 +150,20 @@ struct Agreement {
   double identical_fraction() const { return static_cast<double>(identical) / static_cast<double>(samples); }
 };
 
-Agreement compare_with_reference(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config) {
+// LcdComparison::Synchronised hands the reference the fixed decoder's drive codes after every frame, so each
+// frame's LCD inverse is compared from the same panel state (the comparison the ≤ 1 LSB criterion applies to);
+// FreeRunning lets both decoders keep their own panel history.
+enum class LcdComparison { FreeRunning, Synchronised };
+
+Agreement compare_with_reference(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
+                                 LcdComparison lcd_comparison = LcdComparison::FreeRunning) {
   ReferenceDecoder reference(config.decoder);
   FixedStreamingDecoder fixed(config);
   Agreement agreement;
   for (const LinkFrame& frame : frames) {
     const DecodedFrame expected_frame = reference.decode(frame);
     const DecodedFrame got_frame = fixed.decode(frame);
+    if (lcd_comparison == LcdComparison::Synchronised) reference.adopt_panel_history(got_frame);
     const cv::Mat& expected = expected_frame.drive_codes;
     const cv::Mat& got = got_frame.drive_codes;
     if (config.decoder.panel.kind == PanelKind::Lcd) {
@@ -233,27 +240,62 @@ TEST(FixedDecoder, AgreesWithReferenceOnNoise) {
       "noise 10-bit link+drive");
 }
 
+// Both ways: synchronised, every LCD code within 1 LSB; free-running, the merge the eye sees within one code.
+void expect_lcd_both_ways(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
+                          const std::string& what) {
+  expect_agreement(compare_with_reference(frames, config, LcdComparison::Synchronised), what + " synchronised");
+  expect_lcd_agreement(compare_with_reference(frames, config), what + " free-running");
+}
+
 TEST(FixedDecoder, AgreesWithReferenceOnLcd) {
   for (const std::string& name : scene_names()) {
     const EncoderConfig link = link_config(0.5);
-    expect_lcd_agreement(
-        compare_with_reference(encode_sequence(scene_images(name, 48, 32, 6), link), fixed_config(link, "lcd")),
-        name + " lcd");
+    expect_lcd_both_ways(encode_sequence(scene_images(name, 48, 32, 6), link), fixed_config(link, "lcd"),
+                         name + " lcd");
   }
   for (double r : {1.0, 0.75, 0.4}) {
     const EncoderConfig link = link_config(r);
-    expect_lcd_agreement(
-        compare_with_reference(encode_sequence(noise_images(48, 32, 6, 400), link), fixed_config(link, "lcd")),
-        "noise lcd r=" + std::to_string(r).substr(0, 4));
+    expect_lcd_both_ways(encode_sequence(noise_images(48, 32, 6, 400), link), fixed_config(link, "lcd"),
+                         "noise lcd r=" + std::to_string(r).substr(0, 4));
   }
   const EncoderConfig link = link_config(0.5);
   FixedDecoderConfig contributed = fixed_config(link, "lcd:-0.2,0.3,0.6,0.02,2.4", 10);
   contributed.decoder.lcd_history = LcdHistory::Contributed;
-  expect_lcd_agreement(compare_with_reference(encode_sequence(noise_images(48, 32, 6, 500), link), contributed),
-                   "noise lcd custom contributed 10b");
-  expect_lcd_agreement(
-      compare_with_reference(encode_sequence(scene_images("discs", 48, 32, 6), link), contributed),
-      "discs lcd custom contributed 10b");
+  expect_lcd_both_ways(encode_sequence(noise_images(48, 32, 6, 500), link), contributed,
+                       "noise lcd custom contributed 10b");
+  expect_lcd_both_ways(encode_sequence(scene_images("discs", 48, 32, 6), link), contributed,
+                       "discs lcd custom contributed 10b");
+}
+
+// Longer runs are where free-running codes drift (the neutral mode); synchronised they must not.
+TEST(FixedDecoder, AgreesWithReferenceOnLongLcdRuns) {
+  const EncoderConfig link = link_config(0.5);
+  for (const std::string& name : {std::string("panorama"), std::string("jitter")}) {
+    expect_lcd_both_ways(encode_sequence(scene_images(name, 96, 64, 24), link), fixed_config(link, "lcd"),
+                         name + " lcd 24 frames");
+  }
+}
+
+TEST(ReferenceDecoderLcd, AdoptPanelHistoryRejectsWhatItCannotUse) {
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<LinkFrame> frames = encode_sequence(noise_images(16, 8, 2, 7), link);
+  ReferenceDecoder oled(fixed_config(link).decoder);
+  const DecodedFrame shown = oled.decode(frames[0]);
+  EXPECT_THROW(oled.adopt_panel_history(shown), std::invalid_argument);
+  ReferenceDecoder lcd(fixed_config(link, "lcd").decoder);
+  EXPECT_THROW(lcd.adopt_panel_history(shown), std::invalid_argument);  // no history yet
+  const DecodedFrame first = lcd.decode(frames[0]);
+  DecodedFrame wrong_size = first;
+  wrong_size.drive_codes = cv::Mat::zeros(4, 4, CV_16UC3);
+  EXPECT_THROW(lcd.adopt_panel_history(wrong_size), std::invalid_argument);
+  DecodedFrame too_deep = first;
+  too_deep.drive_codes = cv::Mat(first.drive_codes.size(), CV_16UC3, cv::Scalar::all(256));
+  EXPECT_THROW(lcd.adopt_panel_history(too_deep), std::invalid_argument);
+  // Adopting its own codes changes nothing.
+  ReferenceDecoder twin(fixed_config(link, "lcd").decoder);
+  twin.decode(frames[0]);
+  lcd.adopt_panel_history(first);
+  EXPECT_EQ(cv::norm(lcd.decode(frames[1]).drive_codes, twin.decode(frames[1]).drive_codes, cv::NORM_INF), 0.0);
 }
 
 TEST(FixedDecoder, AgreesWithReferenceAcrossSensitivities) {

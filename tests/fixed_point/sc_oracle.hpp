@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <utility>
 
 namespace trm::fx::testing {
@@ -66,6 +67,35 @@ ScOf<T> to_sc_value(const T& v) {
   s.range(T::width - 1, 0) = static_cast<sc_dt::uint64>(raw_bits(v));
   return s;
 }
+
+// The same SystemC arithmetic through its run-time-parameterised types (sc_fix / sc_ufix, which sc_fixed and
+// sc_ufixed only fix at compile time), so the oracle side of a test compiles once however many formats and
+// mode pairs it covers. Defined in sc_oracle.cpp.
+struct ScFormat {
+  int int_bits = 0;
+  int frac_bits = 0;
+  bool is_signed = true;
+  int width() const { return int_bits + frac_bits; }
+};
+
+template <FixedPoint T>
+constexpr ScFormat sc_format_of() {
+  return {T::int_bits, T::frac_bits, T::is_signed};
+}
+
+// `raw` (the low source.width() bits) read in `source`, assigned to `target` with modes q / o: the target's bits.
+std::uint64_t sc_convert_bits(std::uint64_t raw, ScFormat source, ScFormat target, Quant q, Overflow o);
+
+enum class ScOp { Add, Subtract, Multiply };
+struct ScBinaryResult {
+  std::uint64_t bits = 0;  // the exact result assigned to the target
+  double exact = 0.0;      // the exact (arbitrary-precision) result
+};
+ScBinaryResult sc_binary_bits(ScOp op, std::uint64_t a_raw, ScFormat a, std::uint64_t b_raw, ScFormat b,
+                              ScFormat target, Quant q, Overflow o);
+
+// "sQ4.12 RND/SAT"-style label for failure messages.
+std::string describe(ScFormat format, Quant q, Overflow o);
 
 // Calls f.template operator()<Q, O>() for each of the 7 x 4 quantisation / overflow pairs.
 template <class F>

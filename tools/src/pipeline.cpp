@@ -226,6 +226,10 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   if (options.impl == "fixed-frame") frame_at_a_time.emplace(fixed_config);
   const bool fixed = streaming || frame_at_a_time;
   const bool compare = fixed && options.compare_reference;
+  // LCD codes compared free-running drift apart by the design's neutral mode (see adopt_panel_history); the
+  // synchronised comparison is the criterion, the free-running one is reported beside it.
+  std::optional<ReferenceDecoder> free_running;
+  if (compare && decoder_config.panel.kind == PanelKind::Lcd) free_running.emplace(decoder_config);
 
   std::optional<link::LinkSimulation> simulation;
   PipelineResult result;
@@ -258,6 +262,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       const auto start = std::chrono::steady_clock::now();
       DecodedFrame decoded;
       DecodedFrame reference;
+      DecodedFrame free_running_reference;
       double decode_seconds = -1.0;  // of the decoder under test, not of the reference beside it
       if (fixed) {
         const LinkFrame* to_decode = &view_sent;
@@ -272,7 +277,13 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
         }
         decoded = streaming ? streaming->decode(*to_decode) : frame_at_a_time->decode(*to_decode);
         decode_seconds = seconds_since(start);
-        if (compare) reference = decoder.decode(*to_decode);
+        if (compare) {
+          reference = decoder.decode(*to_decode);
+          if (free_running) {
+            decoder.adopt_panel_history(decoded);
+            free_running_reference = free_running->decode(*to_decode);
+          }
+        }
       } else if (simulation) {
         const link::ReceivedFrame* arrived = nullptr;
         for (const auto& r : received) {
@@ -294,6 +305,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       view.sent = &view_sent;
       view.decoded = &decoded;
       if (compare) view.reference = &reference;
+      if (free_running) view.free_running_reference = &free_running_reference;
       if (fixed) view.fixed_counts = streaming ? &streaming->last_counts() : &frame_at_a_time->last_counts();
       view.render_seconds = render_seconds;
       view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];

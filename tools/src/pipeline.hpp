@@ -69,7 +69,11 @@ struct DecodedView {
   const cv::Mat* linear_full = nullptr;   // what was rendered (full resolution, linear)
   const LinkFrame* sent = nullptr;        // what crossed the link
   const DecodedFrame* decoded = nullptr;  // what the decoder produced
-  const DecodedFrame* reference = nullptr;  // the reference decoder's output, when compared beside a fixed impl
+  // The reference decoder's output, when compared beside a fixed impl. LCD: the reference takes the fixed
+  // decoder's drive codes as its panel history after every frame (ReferenceDecoder::adopt_panel_history), so each
+  // frame's inverse is compared from the same panel state; free_running_reference keeps its own history.
+  const DecodedFrame* reference = nullptr;
+  const DecodedFrame* free_running_reference = nullptr;
   const FixedStageCounts* fixed_counts = nullptr;  // fixed impl: saturation / clip events of this view per stage
   double render_seconds = 0.0;            // producing the source frame (shared by the eyes of a link frame)
   double encode_seconds = 0.0;

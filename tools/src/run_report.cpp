@@ -61,6 +61,19 @@ std::int64_t payload_bytes(const FrameMeta& meta) {
   return (bits + 7) / 8;
 }
 
+std::pair<double, double> RunRecorder::CodeAgreement::add(const cv::Mat& codes, const cv::Mat& reference_codes) {
+  cv::Mat difference;
+  cv::absdiff(codes, reference_codes, difference);
+  const cv::Mat flat = difference.reshape(1);
+  const auto samples = static_cast<std::int64_t>(flat.total());
+  const std::int64_t same = samples - cv::countNonZero(flat);
+  const double max_difference = cv::norm(flat, cv::NORM_INF);
+  compared += samples;
+  identical += same;
+  max_lsb = std::max(max_lsb, max_difference);
+  return {static_cast<double>(same) / static_cast<double>(samples), max_difference};
+}
+
 double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b) {
   const cv::Mat a = to_encoded(linear_a, Transfer::Srgb);
   const cv::Mat b = to_encoded(linear_b, Transfer::Srgb);
@@ -121,17 +134,21 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     have_fixed_counts_ = true;
   }
   if (view.reference) {
-    cv::Mat difference;
-    cv::absdiff(d.drive_codes, view.reference->drive_codes, difference);
-    const cv::Mat flat = difference.reshape(1);
-    const auto samples = static_cast<std::int64_t>(flat.total());
-    const std::int64_t identical = samples - cv::countNonZero(flat);
-    const double max_difference = cv::norm(flat, cv::NORM_INF);
-    compared_codes_ += samples;
-    identical_codes_ += identical;
-    max_code_difference_ = std::max(max_code_difference_, max_difference);
-    rec["vs_reference"] = {{"identical_fraction", static_cast<double>(identical) / static_cast<double>(samples)},
-                           {"max_lsb", max_difference}};
+    const auto [identical, max_lsb] = vs_reference_.add(d.drive_codes, view.reference->drive_codes);
+    rec["vs_reference"] = {{"identical_fraction", identical}, {"max_lsb", max_lsb}};
+    if (panel_.kind == PanelKind::Lcd) rec["vs_reference"]["panel_history"] = "synchronised";
+  }
+  if (view.free_running_reference) {
+    const auto [identical, max_lsb] = vs_free_running_.add(d.drive_codes, view.free_running_reference->drive_codes);
+    cv::Mat merged;
+    cv::Mat merged_reference;
+    cv::pow(d.emitted_linear, 1.0 / panel_.lcd.gamma, merged);
+    cv::pow(view.free_running_reference->emitted_linear, 1.0 / panel_.lcd.gamma, merged_reference);
+    const double merge_codes =
+        cv::norm(merged, merged_reference, cv::NORM_INF) * ((1 << options_.output_bits) - 1);
+    vs_free_running_.max_merge_codes = std::max(vs_free_running_.max_merge_codes, merge_codes);
+    rec["vs_free_running_reference"] = {
+        {"identical_fraction", identical}, {"max_lsb", max_lsb}, {"max_merge_difference_codes", merge_codes}};
   }
   rec["seconds"] = {{"render", view.render_seconds}, {"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
   sum_render_ += view.render_seconds;
@@ -200,10 +217,17 @@ Json RunRecorder::report(double wall_seconds) const {
   s["pairs_exact"] = exact_pairs_;
   s["mean_psnr_db"] = finite_psnr_pairs_ ? json_number(sum_psnr_ / static_cast<double>(finite_psnr_pairs_)) : Json(nullptr);
   s["min_psnr_db"] = finite_psnr_pairs_ ? json_number(min_psnr_) : Json(nullptr);
-  if (compared_codes_ > 0) {
-    s["vs_reference"] = {{"codes_compared", compared_codes_},
-                         {"identical_fraction", static_cast<double>(identical_codes_) / static_cast<double>(compared_codes_)},
-                         {"max_lsb", max_code_difference_}};
+  if (vs_reference_.compared > 0) {
+    s["vs_reference"] = {{"codes_compared", vs_reference_.compared},
+                         {"identical_fraction", vs_reference_.identical_fraction()},
+                         {"max_lsb", vs_reference_.max_lsb}};
+    if (panel_.kind == PanelKind::Lcd) s["vs_reference"]["panel_history"] = "synchronised";
+  }
+  if (vs_free_running_.compared > 0) {
+    s["vs_free_running_reference"] = {{"codes_compared", vs_free_running_.compared},
+                                      {"identical_fraction", vs_free_running_.identical_fraction()},
+                                      {"max_lsb", vs_free_running_.max_lsb},
+                                      {"max_merge_difference_codes", vs_free_running_.max_merge_codes}};
   }
   if (have_fixed_counts_) {
     s["fixed_point_events"] = events_json(fixed_totals_);
@@ -245,11 +269,17 @@ std::string RunRecorder::summary_table() const {
     psnr = "all " + std::to_string(exact_pairs_) + " pairs exact";
   }
   row("perceived pair vs full rate (PSNR)", psnr);
-  if (compared_codes_ > 0) {
+  if (vs_reference_.compared > 0) {
     row(("decoder " + options_.impl + " vs reference").c_str(),
-        fmt("%.4f %% of codes identical", 100.0 * static_cast<double>(identical_codes_) /
-                                               static_cast<double>(compared_codes_)) +
-            fmt(", max %.0f LSB", max_code_difference_));
+        fmt("%.4f %% of codes identical", 100.0 * vs_reference_.identical_fraction()) +
+            fmt(", max %.0f LSB", vs_reference_.max_lsb) +
+            (panel_.kind == PanelKind::Lcd ? " (panel history synchronised)" : ""));
+  }
+  if (vs_free_running_.compared > 0) {
+    row("  free-running (own LCD history)",
+        fmt("%.4f %% identical", 100.0 * vs_free_running_.identical_fraction()) +
+            fmt(", max %.0f LSB", vs_free_running_.max_lsb) +
+            fmt(", merge M within %.3f codes", vs_free_running_.max_merge_codes));
   }
   if (have_fixed_counts_ && fixed_totals_.residual_saturated > 0) {
     row("residual store saturations", std::to_string(fixed_totals_.residual_saturated) + " samples");

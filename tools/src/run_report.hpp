@@ -54,8 +54,16 @@ class RunRecorder {
   double sum_psnr_ = 0, min_psnr_ = 1e300;
   std::int64_t finite_psnr_pairs_ = 0, exact_pairs_ = 0;
   // Fixed-point decoder against the reference beside it: output codes compared.
-  std::int64_t compared_codes_ = 0, identical_codes_ = 0;
-  double max_code_difference_ = 0.0;
+  struct CodeAgreement {
+    std::int64_t compared = 0, identical = 0;
+    double max_lsb = 0.0;
+    double max_merge_codes = 0.0;  // LCD free-running: max |M_fixed - M_reference| in drive codes
+    // Adds one view; returns its {identical fraction, max LSB}.
+    std::pair<double, double> add(const cv::Mat& codes, const cv::Mat& reference_codes);
+    double identical_fraction() const { return compared ? static_cast<double>(identical) / compared : 0.0; }
+  };
+  CodeAgreement vs_reference_;
+  CodeAgreement vs_free_running_;  // LCD only
   FixedStageCounts fixed_totals_;
   bool have_fixed_counts_ = false;
   double sum_render_ = 0;

@@ -92,6 +92,14 @@ class ReferenceDecoder {
   // A view that never arrived: the panel holds this eye's previous output (black if none), and the residual is
   // dropped, so the next reduced frame adds none (DESIGN §4: a reduced frame after a lost frame adds nothing).
   DecodedFrame decode_lost(const FrameMeta& meta);
+  // LCD: replaces this eye's panel history v_{t-1} by the drive codes `shown` put on the panel (same view size,
+  // output_bits codes) - the panel as another decoder drove it. Comparing two implementations of the LCD
+  // inverse frame by frame needs it: v_t is solved against v_{t-1} with dv_t/dv_{t-1} close to -1, so one code
+  // that rounds differently is answered by the opposite difference in the pixel's every later frame (a neutral
+  // mode of the design's rule, not an error), and codes compared free-running drift apart while the merge
+  // M(v_t, v_{t-1}) the eye sees stays within a code. Throws std::invalid_argument for an OLED panel, an eye
+  // with no LCD history yet, or a frame of another size or depth.
+  void adopt_panel_history(const DecodedFrame& shown);
 
  private:
   struct EyeState {
