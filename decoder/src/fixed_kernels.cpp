@@ -373,9 +373,8 @@ Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
   return eotf_->evaluate_raw(static_cast<std::uint32_t>(upsampled));
 }
 
-CompensatedSample FixedKernels::compensate(Raw full_linear, Raw low_linear) const {
+CompensatedSample FixedKernels::split(Raw beta) const {
   CompensatedSample out;
-  const Raw beta = 2 * full_linear - low_linear;  // Eq. 2: beta = 2 I - L, sQ3.F
   out.shown = std::clamp(beta, Raw{0}, one());
   out.clipped = out.shown != beta;
   out.rho = beta - out.shown;  // sQ2.F in [-1, 1]
@@ -717,14 +716,15 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
 
 void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x,
                                   const std::uint16_t* codes_row, const std::uint16_t* low0,
-                                  const std::uint16_t* low1, std::int32_t* residual_row) const {
+                                  const std::uint16_t* low1, std::int32_t* residual_row, bool lost) const {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
   FrameTally& t = out.tally;
   for (int ch = 0; ch < 3; ++ch) {
     const Raw low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
     const Raw full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
-    const CompensatedSample s = kernels_.compensate(full_linear, low_linear);                                // Eq. 2
+    // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
+    const CompensatedSample s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
     if (out.taps != nullptr) {
       tap(out, FixedStage::Linear, y, x, ch, full_linear);
       tap(out, FixedStage::LowPass, y, x, ch, low_linear);
@@ -845,10 +845,11 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
   out.taps = &taps;
 }
 
-DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, bool full, bool residual_applied) {
+DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied) {
   const FrameTally& t = out.tally;
   const double samples = 3.0 * static_cast<double>(out.frame.wanted_linear.total());
   FrameStats& stats = out.frame.stats;
+  stats.concealed_lines = out.concealed_lines;
   stats.clipped_fraction = static_cast<double>(t.clipped) / samples;
   if (full || residual_applied) {
     stats.residual_mean_abs = kernels_.residual_to_double(t.residual_abs_sum) / samples;
@@ -861,7 +862,87 @@ DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, bool full, bool residua
   }
   stats.lcd_unreachable_fraction = static_cast<double>(t.counts.lcd_unreachable) / samples;
   last_counts_ = t.counts;
+  eye.last_output = out.frame;  // the held-output store (drive codes), shared, as the reference keeps it
   return std::move(out.frame);
+}
+
+FixedDecoderCore::Arrival FixedDecoderCore::classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact,
+                                                     Concealment& out, const char* who) {
+  if (line_intact.empty()) return Arrival::Whole;
+  if (line_intact.size() != static_cast<std::size_t>(frame.codes.rows)) {
+    throw std::invalid_argument(std::string(who) + ": line mask has " + std::to_string(line_intact.size()) +
+                                " entries for a view of " + std::to_string(frame.codes.rows) + " lines");
+  }
+  out = Concealment();
+  out.intact = line_intact;
+  out.first_intact = -1;
+  for (int y = 0; y < frame.codes.rows; ++y) {
+    if (out.lost(y)) {
+      ++out.lost_lines;
+    } else if (out.first_intact < 0) {
+      out.first_intact = y;
+    }
+  }
+  if (out.first_intact < 0) return Arrival::Lost;
+  if (out.lost_lines == 0) return Arrival::Whole;
+  // The reference looks at the eye's d_t before a change of view size resets the eye; so does this.
+  const auto found = eyes_.find(frame.meta.eye);
+  if (frame.meta.parity == Parity::Reduced && found != eyes_.end() && found->second.have_residual &&
+      found->second.previous_low.size() == frame.codes.size()) {
+    out.substitute = found->second.previous_low;
+  }
+  return Arrival::Partial;
+}
+
+cv::Mat FixedDecoderCore::concealed_codes(const cv::Mat& codes, const Concealment& c) {
+  cv::Mat out = codes.clone();
+  const int samples = 3 * codes.cols;
+  for (int y = 0; y < codes.rows; ++y) {
+    if (!c.lost(y)) continue;
+    std::uint16_t* row = out.ptr<std::uint16_t>(y);
+    if (!c.substitute.empty()) {
+      const std::uint16_t* stored = c.substitute.ptr<std::uint16_t>(y);
+      for (int i = 0; i < samples; ++i) row[i] = code_of(stored[i]);
+      continue;
+    }
+    // The nearest intact line above, else (lines above the first intact one) below. Lines above y are already
+    // concealed, so the line just above holds the nearest intact line above.
+    const std::uint16_t* source = out.ptr<std::uint16_t>(y < c.first_intact ? c.first_intact : y - 1);
+    std::copy(source, source + samples, row);
+  }
+  return out;
+}
+
+DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
+  if (meta.eye < 0) throw std::invalid_argument(std::string(who) + ": eye must be >= 0");
+  if (meta.full_width < 1 || meta.full_height < 1) {
+    throw std::invalid_argument(std::string(who) + ": full size must be at least 1x1");
+  }
+  const cv::Size full(meta.full_width, meta.full_height);
+  EyeState& eye = eyes_[meta.eye];
+  DecodedFrame out;
+  if (eye.full_size == full && !eye.last_output.drive.empty()) {
+    out = eye.last_output;
+  } else {
+    eye = EyeState();
+    eye.full_size = full;
+    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
+    out.drive = cv::Mat::zeros(full, CV_64FC3);
+    out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
+    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
+  }
+  out.meta = meta;
+  out.meta.width = full.width;
+  out.meta.height = full.height;
+  out.stats = FrameStats();
+  out.stats.frame_lost = true;
+  out.stats.concealed_lines = meta.height;
+  last_counts_ = FixedStageCounts();
+  // The residual belonged to a pair that is now broken (the LCD stores keep the drive the panel still shows).
+  eye.have_residual = false;
+  eye.residual.release();
+  eye.previous_low.release();
+  return out;
 }
 
 }  // namespace fixed_detail

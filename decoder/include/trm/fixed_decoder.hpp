@@ -21,6 +21,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -145,6 +146,9 @@ struct FixedStreamingReport {
   // formats; and this model's residual plus the reduced-size d_t (the LCD stores, needed by both, left out).
   std::int64_t paper_frame_store_bits = 0;
   std::int64_t model_frame_store_bits = 0;
+  // How lost lines and lost views are concealed in raster order, what that costs beyond the buffers above (the
+  // held-output store, listed with them) and its effect on latency.
+  std::string concealment;
 };
 
 // The integer planes of every stage of one decoded frame, for test vectors (FixedFrameDecoder::decode with taps).
@@ -186,6 +190,7 @@ struct FixedStageTaps {
 
 namespace fixed_detail {
 class FixedDecoderCore;
+struct Concealment;
 }
 
 // Frame-at-a-time schedule.
@@ -201,11 +206,17 @@ class FixedFrameDecoder {
   DecodedFrame decode(const LinkFrame& frame);
   // The same, also filling taps with every stage's integer plane of this frame (the others are not present).
   DecodedFrame decode(const LinkFrame& frame, FixedStageTaps& taps);
+  // As ReferenceDecoder::decode(frame, line_intact): a view received over a faulty link, line_intact holding one
+  // entry per line of frame.codes (0 = lost; empty = none lost), concealed by the reference's rules.
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  // As ReferenceDecoder::decode_lost: the panel holds this eye's previous output (black if none), the residual is
+  // dropped.
+  DecodedFrame decode_lost(const FrameMeta& meta);
   const FixedStageCounts& last_counts() const;
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps);
+  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps, const fixed_detail::Concealment* lost);
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
@@ -218,12 +229,17 @@ class FixedStreamingDecoder {
 
   const FixedDecoderConfig& config() const;
   DecodedFrame decode(const LinkFrame& frame);
+  // Concealment as FixedFrameDecoder (bit-identical), with every lost line replaced as it arrives, in raster order
+  // (see FixedStreamingReport::concealment).
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  DecodedFrame decode_lost(const FrameMeta& meta);
   const FixedStageCounts& last_counts() const;
   // Latency, line buffers / frame stores, ROMs and arithmetic per stage for a view of the given full size.
   FixedStreamingReport report(cv::Size full) const;
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
+  DecodedFrame decode_impl(const LinkFrame& frame, const fixed_detail::Concealment* lost);
 };
 
 }  // namespace trm
