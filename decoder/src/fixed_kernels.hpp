@@ -123,12 +123,19 @@ class FixedKernels {
   // I = lin(E): direct ROM indexed by the link code; uQ1.F.
   Raw linear_of_code(std::uint16_t code) const { return code_rom_[code]; }
 
+  bool linear_space() const { return linear_space_; }
   // D, horizontal half: sum_i w_i E_i over one row of codes (channel ch of interleaved RGB), uQb.L (L = line bits).
+  // Linear space: sum_i w_i lin(E_i), uQ1.P.
   Raw gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const;
   // D, vertical half, and Q_b: d = round(sum_j w_j h_j) where rows[j] is the line buffer row of tap j; a link code,
-  // with kTieFlag set when the sum was exactly half-way (strip it with code_of for arithmetic).
+  // with kTieFlag set when the sum was exactly half-way (strip it with code_of for arithmetic). Linear space: the sum
+  // rounded to uQ1.P and re-encoded through the threshold ROM (never flagged).
   std::uint16_t gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const;
+  // Linear space: the link code the encoder gives linear value x (uQ1.P): the largest k with x >= T_k.
+  std::uint16_t encode_linear(Raw x) const;
 
+  // The U functions return U's output: in the encoded space codes uQb.U (linear_of_upsampled applies the EOTF LUT);
+  // in the linear space linear light uQ1.F, blended from lin(code) (linear_of_upsampled passes it through).
   // U: bilinear blend of reduced codes rows row0 (i0) and row1 (i1) at full column x, channel ch; codes uQb.U.
   Raw upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col, Raw row_upper,
                int ch) const;
@@ -139,9 +146,10 @@ class FixedKernels {
   Raw upsample_stored(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col,
                       Raw row_upper, int ch) const;
   bool has_tie(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col, int ch) const;
-  // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd).
+  // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd); linear space: four codes through
+  // the I ROM, result uQ1.F (Rnd).
   Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
-  // lin() of U's encoded output through the interpolated EOTF LUT; uQ1.F.
+  // lin() of U's encoded output through the interpolated EOTF LUT; uQ1.F. Linear space: U's output as it is.
   Raw linear_of_upsampled(Raw upsampled) const;
 
   // Eq. 2: beta = 2 I - L (sQ3.F), shown = clamp(beta, 0, 1), rho = beta - shown.
@@ -185,7 +193,11 @@ class FixedKernels {
  private:
   FixedDecoderConfig config_;
   std::vector<Raw> code_rom_;
-  std::unique_ptr<fx::InterpolatedLut> eotf_;
+  std::unique_ptr<fx::InterpolatedLut> eotf_;  // encoded space only
+  // Linear resample space: D's input lin(E) (uQ1.P) and the re-encoding thresholds T_k (uQ1.P, T_0 = 0).
+  bool linear_space_ = false;
+  std::vector<Raw> resample_rom_;
+  std::vector<Raw> encode_thresholds_;
   std::unique_ptr<fx::InterpolatedLut> reciprocal_;
   std::unique_ptr<fx::InterpolatedLut> exp_fraction_;
   std::vector<Raw> exp_integer_rom_;  // exp(-i), i = 0..15, uQ1.F

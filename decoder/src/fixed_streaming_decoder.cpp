@@ -144,18 +144,28 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
   r.reduced = g.reduced;
   r.roms = core_->kernels().roms();
   r.arithmetic = core_->kernels().arithmetic(g);
+  // The linear resample space keeps D's horizontal results as linear light (uQ1.P) and d_t without the exact-tie
+  // flag (there are no exact half-code ties to resolve).
+  const bool linear = c.decoder.link.resample_space == ResampleSpace::Linear;
+  const int gauss_bits = linear ? 1 + c.linear_resample_frac_bits : b + c.gaussian_line_frac_bits;
+  const int low_bits = linear ? b : b + 1;
   r.buffers = {
-      {"line: vertical Gaussian (horizontal D results, uQb.L)", p.gauss_lines, 3 * g.reduced.width, b + c.gaussian_line_frac_bits},
+      {linear ? "line: vertical Gaussian (horizontal D results, linear uQ1." +
+                    std::to_string(c.linear_resample_frac_bits) + ")"
+              : std::string("line: vertical Gaussian (horizontal D results, uQb.L)"),
+       p.gauss_lines, 3 * g.reduced.width, gauss_bits},
       {"line: E_t delay for I_t (link codes)", p.delay_lines, 3 * g.full.width, b},
       {"line: U of d_t (full frames, codes)", p.low_lines, 3 * g.reduced.width, b},
       {"line: U of i (reduced frames, codes)", p.reduced_lines, 3 * g.reduced.width, b},
       {"frame: residual rho (" + c.residual.to_string() + ")", g.full.height, 3 * g.full.width, c.residual.width()},
-      {"frame: d_t for the motion test (codes + exact-tie flag)", g.reduced.height, 3 * g.reduced.width, b + 1},
+      {linear ? std::string("frame: d_t for the motion test (codes)")
+              : std::string("frame: d_t for the motion test (codes + exact-tie flag)"),
+       g.reduced.height, 3 * g.reduced.width, low_bits},
   };
   const std::int64_t full_samples = 3 * static_cast<std::int64_t>(g.full.area());
   const std::int64_t reduced_samples = 3 * static_cast<std::int64_t>(g.reduced.area());
   r.paper_frame_store_bits = full_samples * b + full_samples * c.residual.width();
-  r.model_frame_store_bits = reduced_samples * (b + 1) + full_samples * c.residual.width();
+  r.model_frame_store_bits = reduced_samples * low_bits + full_samples * c.residual.width();
   const bool lcd = c.decoder.panel.kind == PanelKind::Lcd;
   if (lcd) {
     r.buffers.push_back({"frame: LCD v_{t-1} (drive codes; re-shown when a view is lost)", g.full.height,

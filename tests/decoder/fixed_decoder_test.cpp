@@ -253,7 +253,13 @@ TEST(FixedDecoder, RejectsBadConfiguration) {
   expect_rejected(c, "motion weight");
   c = good;
   c.decoder.link.resample_space = ResampleSpace::Linear;
-  expect_rejected(c, "resample space");
+  EXPECT_NO_THROW(FixedStreamingDecoder{c});
+  c.decoder.link.bits = 10;
+  c.decoder.link.transfer = Transfer::Gamma22;
+  c.linear_resample_frac_bits = 16;  // (0.5/1023)^2.2 and (1.5/1023)^2.2 both round up to 2^-16
+  expect_rejected(c, "D (linear resample space)");
+  c.linear_resample_frac_bits = 36;  // 36 + 28 > 62
+  expect_rejected(c, "D (linear resample space)");
 }
 
 TEST(FixedDecoder, RejectsMismatchedFrames) {
