@@ -50,10 +50,24 @@ FixedFrameDecoder& FixedFrameDecoder::operator=(FixedFrameDecoder&&) noexcept = 
 const FixedDecoderConfig& FixedFrameDecoder::config() const { return core_->config(); }
 const FixedStageCounts& FixedFrameDecoder::last_counts() const { return core_->last_counts(); }
 
-DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame) { return decode_impl(frame, nullptr); }
+DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame) { return decode_impl(frame, nullptr, nullptr); }
+
+DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
+  fixed_detail::Concealment lost;
+  switch (core_->classify(frame, line_intact, lost, "FixedFrameDecoder")) {
+    case FixedDecoderCore::Arrival::Whole: return decode_impl(frame, nullptr, nullptr);
+    case FixedDecoderCore::Arrival::Lost: return core_->decode_lost(frame.meta, "FixedFrameDecoder");
+    case FixedDecoderCore::Arrival::Partial: break;
+  }
+  return decode_impl(frame, nullptr, &lost);
+}
+
+DecodedFrame FixedFrameDecoder::decode_lost(const FrameMeta& meta) {
+  return core_->decode_lost(meta, "FixedFrameDecoder");
+}
 
 DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, FixedStageTaps& taps) {
-  DecodedFrame decoded = decode_impl(frame, &taps);
+  DecodedFrame decoded = decode_impl(frame, &taps, nullptr);
   // The planes held outside the per-pixel stages: received codes and drive codes.
   const auto copy_codes = [](const cv::Mat& m, FixedStagePlane& p) {
     for (int y = 0; y < m.rows; ++y) {
@@ -66,11 +80,16 @@ DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, FixedStageTaps& t
   return decoded;
 }
 
-DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& frame, FixedStageTaps* taps) {
-  fixed_detail::EyeState& eye = core_->begin(frame, "FixedFrameDecoder");
+DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStageTaps* taps,
+                                            const fixed_detail::Concealment* lost) {
+  fixed_detail::EyeState& eye = core_->begin(received, "FixedFrameDecoder");
+  // Concealment: every lost line replaced first, then the view decoded as if it had arrived so.
+  const LinkFrame frame = lost != nullptr ? LinkFrame{received.meta, FixedDecoderCore::concealed_codes(received.codes, *lost)}
+                                          : received;
   const Geometry& g = core_->kernels().geometry(eye.full_size);
   fixed_detail::FrameOutput out = core_->start_output(frame);
   out.full = frame.meta.parity == Parity::Full;
+  out.concealed_lines = lost != nullptr ? lost->lost_lines : 0;
   core_->begin_lcd(out, eye);
   if (taps != nullptr) {
     core_->start_taps(out, *taps, g, out.full,
@@ -103,14 +122,14 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& frame, FixedStageTa
       const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
       for (int x = 0; x < g.full.width; ++x) {
         core_->full_pixel(out, eye, g, y, x, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
-                          residual.ptr<std::int32_t>(y));
+                          residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y));
       }
     }
     eye.have_residual = true;
     eye.residual_index = frame.meta.index;
     eye.residual = residual;
     eye.previous_low = low_store;
-    return core_->finish(std::move(out), true, false);
+    return core_->finish(std::move(out), eye, true, false);
   }
 
   const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
@@ -131,7 +150,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& frame, FixedStageTa
   eye.have_residual = false;
   eye.residual.release();
   eye.previous_low.release();
-  return core_->finish(std::move(out), false, residual_applies);
+  return core_->finish(std::move(out), eye, false, residual_applies);
 }
 
 }  // namespace trm

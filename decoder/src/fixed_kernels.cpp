@@ -76,6 +76,25 @@ std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, in
   return out;
 }
 
+// The linear resample space's re-encoding thresholds on the uQ1.frac_bits grid: T_k is the smallest grid value g
+// whose link code under the encoder's quantiser, floor(enc(g 2^-f) (2^b - 1) + 1/2), is k or more (T_0 = 0). The code
+// of any grid value x is then the largest k with x >= T_k, exactly as the encoder quantises that value.
+std::vector<std::int64_t> link_code_thresholds(int bits, Transfer transfer, int frac_bits) {
+  const int top = (1 << bits) - 1;
+  const auto code_of_grid = [&](std::int64_t g) {
+    const double encoded = std::clamp(to_encoded(std::ldexp(static_cast<double>(g), -frac_bits), transfer), 0.0, 1.0);
+    return static_cast<int>(std::floor(encoded * top + 0.5));
+  };
+  std::vector<std::int64_t> t(static_cast<std::size_t>(top) + 1, 0);
+  for (int k = 1; k <= top; ++k) {
+    auto g = static_cast<std::int64_t>(std::ceil(std::ldexp(to_linear((k - 0.5) / top, transfer), frac_bits)));
+    while (g > 0 && code_of_grid(g - 1) >= k) --g;
+    while (code_of_grid(g) < k) ++g;
+    t[static_cast<std::size_t>(k)] = g;
+  }
+  return t;
+}
+
 }  // namespace
 
 void FixedDecoderConfig::validate() const {
@@ -103,10 +122,28 @@ void FixedDecoderConfig::validate() const {
       reject("LCD drive (target LUT)", "lcd_segments_per_octave must be a power of two in [1, 2048]");
     }
   }
-  if (link.resample_space != ResampleSpace::Encoded) {
-    reject("D/U resample space", "the fixed-point decoders resample in the encoded space only");
-  }
   require_range("linear light", "linear_frac_bits", linear_frac_bits, 8, 28);
+  if (link.resample_space == ResampleSpace::Linear) {
+    const std::string stage = "D (linear resample space)";
+    require_range(stage, "linear_resample_frac_bits", linear_resample_frac_bits, 16, 40);
+    require_range(stage, "linear_gaussian_tap_frac_bits", linear_gaussian_tap_frac_bits, 8, 30);
+    if (linear_resample_frac_bits + linear_gaussian_tap_frac_bits > 62) {
+      reject(stage, "lin(E) x taps accumulator exceeds 62 bits (linear_resample_frac_bits + "
+                    "linear_gaussian_tap_frac_bits > 62)");
+    }
+    const std::vector<std::int64_t> t = link_code_thresholds(link.bits, link.transfer, linear_resample_frac_bits);
+    for (std::size_t k = 1; k < t.size(); ++k) {
+      if (t[k] <= t[k - 1]) {
+        reject(stage, "uQ1." + std::to_string(linear_resample_frac_bits) + " is too narrow to re-encode " +
+                          std::to_string(link.bits) + "-bit " + to_string(link.transfer) + " codes: the thresholds of "
+                          "codes " + std::to_string(k - 1) + " and " + std::to_string(k) + " collapse");
+      }
+    }
+    if (1 + linear_frac_bits + 2 * bilinear_weight_frac_bits > 62) {
+      reject("U (linear resample space)", "lin(d) x weights accumulator exceeds 62 bits (1 + linear_frac_bits + 2 "
+                                          "bilinear_weight_frac_bits > 62)");
+    }
+  }
   require_range("D (Gaussian taps)", "gaussian_tap_frac_bits", gaussian_tap_frac_bits, 8, 30);
   require_range("D (line buffer)", "gaussian_line_frac_bits", gaussian_line_frac_bits, 0, 30);
   if (link.bits + gaussian_line_frac_bits + gaussian_tap_frac_bits > 62) {
@@ -175,17 +212,32 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
         fx::quantise_double(to_linear(static_cast<double>(code) / max_code(), link.transfer), linear_format);
   }
 
+  linear_space_ = link.resample_space == ResampleSpace::Linear;
+  if (linear_space_) {
+    // D in linear light: lin(E) at D's precision, and the thresholds that re-encode D's result to link codes.
+    const fx::RuntimeFormat resample_format{1, config_.linear_resample_frac_bits, false, fx::Quant::Rnd,
+                                            fx::Overflow::Sat};
+    resample_rom_.resize(static_cast<std::size_t>(max_code()) + 1);
+    for (int code = 0; code <= max_code(); ++code) {
+      resample_rom_[static_cast<std::size_t>(code)] =
+          fx::quantise_double(to_linear(static_cast<double>(code) / max_code(), link.transfer), resample_format);
+    }
+    encode_thresholds_ = link_code_thresholds(link.bits, link.transfer, config_.linear_resample_frac_bits);
+  }
+
   // L = lin(U(d)): the address is U's output in codes uQb.U; segments aligned to code steps make the segment
-  // index and weight plain bit fields of the address.
+  // index and weight plain bit fields of the address. (Encoded space only: in linear space U outputs linear light.)
   fx::LutShape eotf_shape;
   eotf_shape.entries = (max_code() << config_.eotf_segments_per_code_log2) + 1;
   eotf_shape.input_bits = link.bits + config_.upsample_frac_bits;
   eotf_shape.output_bits = 1 + F;
   eotf_shape.output_frac_bits = F;
   const Transfer transfer = link.transfer;
-  eotf_ = std::make_unique<fx::InterpolatedLut>(
-      "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.upsample_frac_bits),
-      [transfer](double t) { return to_linear(t, transfer); });
+  if (!linear_space_) {
+    eotf_ = std::make_unique<fx::InterpolatedLut>(
+        "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.upsample_frac_bits),
+        [transfer](double t) { return to_linear(t, transfer); });
+  }
 
   // Eq. 5: Rec. 709 weights summing exactly to 2^W; 1/x through the normalised reciprocal LUT (uQ2.24 holds 1.0).
   const std::vector<std::int64_t> luma =
@@ -282,12 +334,13 @@ const Geometry& FixedKernels::geometry(cv::Size full) {
   g.full = full;
   g.reduced = cv::Size(reduced_size(full.width, link.reduction), reduced_size(full.height, link.reduction));
   const double sigma = link.effective_sigma();
+  const int tap_bits = linear_space_ ? config_.linear_gaussian_tap_frac_bits : config_.gaussian_tap_frac_bits;
   const auto gauss_axis = [&](int full_n, int reduced_n) {
     std::vector<PolyphaseTaps> axis(static_cast<std::size_t>(reduced_n));
     for (int k = 0; k < reduced_n; ++k) {
       const GaussianTaps taps = gaussian_taps(k, full_n, reduced_n, sigma);
       PolyphaseTaps& out = axis[static_cast<std::size_t>(k)];
-      out.weight = integer_weights(taps.weights, config_.gaussian_tap_frac_bits);
+      out.weight = integer_weights(taps.weights, tap_bits);
       for (std::size_t i = 0; i < taps.weights.size(); ++i) {
         out.index.push_back(std::clamp(taps.first_index + static_cast<int>(i), 0, full_n - 1));
       }
@@ -312,6 +365,13 @@ const Geometry& FixedKernels::geometry(cv::Size full) {
 }
 
 Raw FixedKernels::gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const {
+  if (linear_space_) {
+    Raw acc = 0;  // uQ1.P x uQ0.T
+    for (std::size_t i = 0; i < taps.weight.size(); ++i) {
+      acc += taps.weight[i] * resample_rom_[codes_row[3 * taps.index[i] + ch]];
+    }
+    return round_shift(acc, config_.linear_gaussian_tap_frac_bits);  // uQ1.P
+  }
   Raw acc = 0;  // codes x uQ0.T
   for (std::size_t i = 0; i < taps.weight.size(); ++i) acc += taps.weight[i] * codes_row[3 * taps.index[i] + ch];
   // uQb.L, half to even: rows a, b with a + b an integer (255 - pattern) keep a + b exact, so an exact half-code
@@ -321,8 +381,9 @@ Raw FixedKernels::gaussian_horizontal(const std::uint16_t* codes_row, const Poly
 }
 
 std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const {
-  Raw acc = 0;  // uQb.(L + T)
+  Raw acc = 0;  // uQb.(L + T); linear space uQ1.(P + T)
   for (std::size_t j = 0; j < taps.weight.size(); ++j) acc += taps.weight[j] * rows[j][sample];
+  if (linear_space_) return encode_linear(round_shift(acc, config_.linear_gaussian_tap_frac_bits));
   // Q_b: the nearest code, as the encoder's floor(x + 1/2); taps sum to 1, so no clamp is needed.
   const int shift = config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits;
   const auto code = static_cast<std::uint16_t>(round_shift(acc, shift));
@@ -331,9 +392,28 @@ std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const Poly
   return static_cast<std::uint16_t>(code | (tie ? kTieFlag : 0));
 }
 
+std::uint16_t FixedKernels::encode_linear(Raw x) const {
+  // Binary search over the threshold ROM: b comparisons per reduced sample.
+  int lo = 0;
+  int hi = max_code();
+  while (lo < hi) {
+    const int mid = (lo + hi + 1) / 2;
+    if (x >= encode_thresholds_[static_cast<std::size_t>(mid)]) lo = mid; else hi = mid - 1;
+  }
+  return static_cast<std::uint16_t>(lo);
+}
+
 Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper,
                         Raw row_upper) const {
   const Raw unit = Raw{1} << config_.bilinear_weight_frac_bits;
+  if (linear_space_) {
+    // U on linear light: the four codes through the I ROM (uQ1.F), result uQ1.F.
+    const Raw top = (unit - col_upper) * code_rom_[static_cast<std::size_t>(top_left)] +
+                    col_upper * code_rom_[static_cast<std::size_t>(top_right)];
+    const Raw bottom = (unit - col_upper) * code_rom_[static_cast<std::size_t>(bottom_left)] +
+                       col_upper * code_rom_[static_cast<std::size_t>(bottom_right)];
+    return round_shift((unit - row_upper) * top + row_upper * bottom, 2 * config_.bilinear_weight_frac_bits);
+  }
   const Raw top = (unit - col_upper) * top_left + col_upper * top_right;            // uQb.W
   const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
   const Raw blended = (unit - row_upper) * top + row_upper * bottom;               // uQb.2W
@@ -370,12 +450,12 @@ Raw FixedKernels::upsample_previous(const std::uint16_t* stored0, const std::uin
 }
 
 Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
+  if (linear_space_) return upsampled;
   return eotf_->evaluate_raw(static_cast<std::uint32_t>(upsampled));
 }
 
-CompensatedSample FixedKernels::compensate(Raw full_linear, Raw low_linear) const {
+CompensatedSample FixedKernels::split(Raw beta) const {
   CompensatedSample out;
-  const Raw beta = 2 * full_linear - low_linear;  // Eq. 2: beta = 2 I - L, sQ3.F
   out.shown = std::clamp(beta, Raw{0}, one());
   out.clipped = out.shown != beta;
   out.rho = beta - out.shown;  // sQ2.F in [-1, 1]
@@ -551,9 +631,21 @@ std::vector<FixedRomReport> FixedKernels::roms() const {
   const int F = config_.linear_frac_bits;
   const int top = max_output_code();
   std::vector<FixedRomReport> out;
-  out.push_back({"I = lin(E): direct ROM per link code (uQ1." + std::to_string(F) + ")",
-                 static_cast<int>(code_rom_.size()), 1 + F, 1});
-  out.push_back(lut("L, alpha = lin(U(.)): interpolated EOTF LUT", *eotf_));
+  if (linear_space_) {
+    const int P = config_.linear_resample_frac_bits;
+    const int b = config_.decoder.link.bits;
+    out.push_back({"I = lin(E), lin(d|i) for U: direct ROM per code (uQ1." + std::to_string(F) + ")",
+                   static_cast<int>(code_rom_.size()), 1 + F, 1});
+    out.push_back({"D input lin(E): direct ROM per link code (uQ1." + std::to_string(P) + ")",
+                   static_cast<int>(resample_rom_.size()), 1 + P, 1});
+    out.push_back({"D re-encoding to " + std::to_string(b) + "-bit link codes: thresholds T_k (uQ1." +
+                       std::to_string(P) + ")",
+                   static_cast<int>(encode_thresholds_.size()), 1 + P, 1});
+  } else {
+    out.push_back({"I = lin(E): direct ROM per link code (uQ1." + std::to_string(F) + ")",
+                   static_cast<int>(code_rom_.size()), 1 + F, 1});
+    out.push_back(lut("L, alpha = lin(U(.)): interpolated EOTF LUT", *eotf_));
+  }
   out.push_back(lut("Eq. 5 1/(Yp + Ya): normalised reciprocal LUT", *reciprocal_));
   out.push_back({"Eq. 6 exp(-i), i = 0..15", static_cast<int>(exp_integer_rom_.size()), 1 + F, 1});
   out.push_back(lut("Eq. 6 exp(-f), f in [0, 1): interpolated LUT", *exp_fraction_));
@@ -589,6 +681,13 @@ std::vector<FixedRomReport> FixedKernels::roms() const {
 // | Eq. 4 alpha'                   | sample         | 2                 | 1           | 2           | 0         |
 // | OLED drive code (search)       | sample         | 0                 | 0           | o           | o         |
 // | LCD drive code (Eq. 7 inverse) | sample         | 4 + 6 o           | 2 + 8 o     | 2 + o       | 4         |
+//
+// In the linear resample space D reads lin(E) from a ROM per tap and re-encodes through the threshold ROM, U reads
+// lin(code) from the I ROM per corner, and there is neither an EOTF LUT nor an exact-tie resolution:
+//
+// | D horizontal on lin(E) (n_h)   | reduced sample | n_h               | n_h         | 0           | n_h       |
+// | D vertical + re-encoding (n_v) | reduced sample | n_v               | n_v         | b           | b         |
+// | U bilinear of lin(.)           | sample         | 6                 | 6           | 0           | 4         |
 std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) const {
   const auto widest = [](const std::vector<PolyphaseTaps>& axis) {
     std::size_t n = 0;
@@ -602,6 +701,33 @@ std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) c
   const std::int64_t samples = 3 * pixels;
   const std::int64_t horizontal = 3 * static_cast<std::int64_t>(g.reduced.width) * g.full.height;
   const std::int64_t vertical = 3 * static_cast<std::int64_t>(g.reduced.width) * g.reduced.height;
+  if (linear_space_) {
+    const int b = config_.decoder.link.bits;
+    std::vector<FixedArithmeticReport> out = {
+        {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
+        {"D horizontal on lin(E) (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line",
+         horizontal, n_h, n_h, 0, n_h},
+        {"D vertical + re-encode (" + std::to_string(n_v) + " taps, " + std::to_string(b) + " steps)", "full",
+         "reduced sample", vertical, n_v, n_v, b, b},
+        {"U bilinear of lin(d_t): L", "full", "channel sample", samples, 6, 6, 0, 4},
+        {"Eq. 2 beta = 2I - L, shown, rho", "full", "channel sample", samples, 2, 0, 2, 0},
+        {"residual store (round, saturate)", "full", "channel sample", samples, 1, 0, 2, 0},
+        {"U bilinear of lin(i): alpha", "reduced", "channel sample", samples, 6, 6, 0, 4},
+        {"U bilinear of lin(d_{t-1}): L_{t-1}", "reduced", "channel sample", samples, 6, 6, 0, 4},
+        {"luma of L_{t-1} and alpha", "reduced", "pixel", pixels, 6, 6, 0, 0},
+        {"Eq. 5 motion contrast c", "reduced", "pixel", pixels, 6, 2, 3, 2},
+        {"Eq. 6 weight w = exp(-s c)", "reduced", "pixel", pixels, 5, 3, 1, 3},
+        {"Eq. 4 alpha' = clamp(alpha + w rho)", "reduced", "channel sample", samples, 2, 1, 2, 0},
+    };
+    if (lcd_) {
+      out.push_back({"LCD drive code (Eq. 7 inverse, " + std::to_string(o) + "-step search)", "both",
+                     "channel sample", samples, 4 + 6 * o, 2 + 8 * o, 2 + o, 4});
+    } else {
+      out.push_back({"OLED drive code (" + std::to_string(o) + "-step threshold search)", "both", "channel sample",
+                     samples, 0, 0, o, o});
+    }
+    return out;
+  }
   std::vector<FixedArithmeticReport> out = {
       {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
       {"D horizontal (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line", horizontal,
@@ -717,14 +843,15 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
 
 void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x,
                                   const std::uint16_t* codes_row, const std::uint16_t* low0,
-                                  const std::uint16_t* low1, std::int32_t* residual_row) const {
+                                  const std::uint16_t* low1, std::int32_t* residual_row, bool lost) const {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
   FrameTally& t = out.tally;
   for (int ch = 0; ch < 3; ++ch) {
     const Raw low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
     const Raw full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
-    const CompensatedSample s = kernels_.compensate(full_linear, low_linear);                                // Eq. 2
+    // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
+    const CompensatedSample s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
     if (out.taps != nullptr) {
       tap(out, FixedStage::Linear, y, x, ch, full_linear);
       tap(out, FixedStage::LowPass, y, x, ch, low_linear);
@@ -824,7 +951,11 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
   add(FixedStage::Codes, "codes", code, b, false, full ? g.full : g.reduced, 3);
   if (full) {
     add(FixedStage::Linear, "I", linear, 1 + F, false, g.full, 3);
-    add(FixedStage::Reduced, "d", code + " + exact-tie flag in bit " + std::to_string(b), b + 1, false, g.reduced, 3);
+    if (kernels_.linear_space()) {
+      add(FixedStage::Reduced, "d", code, b, false, g.reduced, 3);
+    } else {
+      add(FixedStage::Reduced, "d", code + " + exact-tie flag in bit " + std::to_string(b), b + 1, false, g.reduced, 3);
+    }
     add(FixedStage::LowPass, "L", linear, 1 + F, false, g.full, 3);
     add(FixedStage::Beta, "beta", "sQ3." + std::to_string(F), 3 + F, true, g.full, 3);
     add(FixedStage::Shown, "shown", linear, 1 + F, false, g.full, 3);
@@ -845,10 +976,11 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
   out.taps = &taps;
 }
 
-DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, bool full, bool residual_applied) {
+DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied) {
   const FrameTally& t = out.tally;
   const double samples = 3.0 * static_cast<double>(out.frame.wanted_linear.total());
   FrameStats& stats = out.frame.stats;
+  stats.concealed_lines = out.concealed_lines;
   stats.clipped_fraction = static_cast<double>(t.clipped) / samples;
   if (full || residual_applied) {
     stats.residual_mean_abs = kernels_.residual_to_double(t.residual_abs_sum) / samples;
@@ -861,7 +993,87 @@ DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, bool full, bool residua
   }
   stats.lcd_unreachable_fraction = static_cast<double>(t.counts.lcd_unreachable) / samples;
   last_counts_ = t.counts;
+  eye.last_output = out.frame;  // the held-output store (drive codes), shared, as the reference keeps it
   return std::move(out.frame);
+}
+
+FixedDecoderCore::Arrival FixedDecoderCore::classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact,
+                                                     Concealment& out, const char* who) {
+  if (line_intact.empty()) return Arrival::Whole;
+  if (line_intact.size() != static_cast<std::size_t>(frame.codes.rows)) {
+    throw std::invalid_argument(std::string(who) + ": line mask has " + std::to_string(line_intact.size()) +
+                                " entries for a view of " + std::to_string(frame.codes.rows) + " lines");
+  }
+  out = Concealment();
+  out.intact = line_intact;
+  out.first_intact = -1;
+  for (int y = 0; y < frame.codes.rows; ++y) {
+    if (out.lost(y)) {
+      ++out.lost_lines;
+    } else if (out.first_intact < 0) {
+      out.first_intact = y;
+    }
+  }
+  if (out.first_intact < 0) return Arrival::Lost;
+  if (out.lost_lines == 0) return Arrival::Whole;
+  // The reference looks at the eye's d_t before a change of view size resets the eye; so does this.
+  const auto found = eyes_.find(frame.meta.eye);
+  if (frame.meta.parity == Parity::Reduced && found != eyes_.end() && found->second.have_residual &&
+      found->second.previous_low.size() == frame.codes.size()) {
+    out.substitute = found->second.previous_low;
+  }
+  return Arrival::Partial;
+}
+
+cv::Mat FixedDecoderCore::concealed_codes(const cv::Mat& codes, const Concealment& c) {
+  cv::Mat out = codes.clone();
+  const int samples = 3 * codes.cols;
+  for (int y = 0; y < codes.rows; ++y) {
+    if (!c.lost(y)) continue;
+    std::uint16_t* row = out.ptr<std::uint16_t>(y);
+    if (!c.substitute.empty()) {
+      const std::uint16_t* stored = c.substitute.ptr<std::uint16_t>(y);
+      for (int i = 0; i < samples; ++i) row[i] = code_of(stored[i]);
+      continue;
+    }
+    // The nearest intact line above, else (lines above the first intact one) below. Lines above y are already
+    // concealed, so the line just above holds the nearest intact line above.
+    const std::uint16_t* source = out.ptr<std::uint16_t>(y < c.first_intact ? c.first_intact : y - 1);
+    std::copy(source, source + samples, row);
+  }
+  return out;
+}
+
+DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
+  if (meta.eye < 0) throw std::invalid_argument(std::string(who) + ": eye must be >= 0");
+  if (meta.full_width < 1 || meta.full_height < 1) {
+    throw std::invalid_argument(std::string(who) + ": full size must be at least 1x1");
+  }
+  const cv::Size full(meta.full_width, meta.full_height);
+  EyeState& eye = eyes_[meta.eye];
+  DecodedFrame out;
+  if (eye.full_size == full && !eye.last_output.drive.empty()) {
+    out = eye.last_output;
+  } else {
+    eye = EyeState();
+    eye.full_size = full;
+    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
+    out.drive = cv::Mat::zeros(full, CV_64FC3);
+    out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
+    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
+  }
+  out.meta = meta;
+  out.meta.width = full.width;
+  out.meta.height = full.height;
+  out.stats = FrameStats();
+  out.stats.frame_lost = true;
+  out.stats.concealed_lines = meta.height;
+  last_counts_ = FixedStageCounts();
+  // The residual belonged to a pair that is now broken (the LCD stores keep the drive the panel still shows).
+  eye.have_residual = false;
+  eye.residual.release();
+  eye.previous_low.release();
+  return out;
 }
 
 }  // namespace fixed_detail

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -122,12 +123,19 @@ class FixedKernels {
   // I = lin(E): direct ROM indexed by the link code; uQ1.F.
   Raw linear_of_code(std::uint16_t code) const { return code_rom_[code]; }
 
+  bool linear_space() const { return linear_space_; }
   // D, horizontal half: sum_i w_i E_i over one row of codes (channel ch of interleaved RGB), uQb.L (L = line bits).
+  // Linear space: sum_i w_i lin(E_i), uQ1.P.
   Raw gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const;
   // D, vertical half, and Q_b: d = round(sum_j w_j h_j) where rows[j] is the line buffer row of tap j; a link code,
-  // with kTieFlag set when the sum was exactly half-way (strip it with code_of for arithmetic).
+  // with kTieFlag set when the sum was exactly half-way (strip it with code_of for arithmetic). Linear space: the sum
+  // rounded to uQ1.P and re-encoded through the threshold ROM (never flagged).
   std::uint16_t gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const;
+  // Linear space: the link code the encoder gives linear value x (uQ1.P): the largest k with x >= T_k.
+  std::uint16_t encode_linear(Raw x) const;
 
+  // The U functions return U's output: in the encoded space codes uQb.U (linear_of_upsampled applies the EOTF LUT);
+  // in the linear space linear light uQ1.F, blended from lin(code) (linear_of_upsampled passes it through).
   // U: bilinear blend of reduced codes rows row0 (i0) and row1 (i1) at full column x, channel ch; codes uQb.U.
   Raw upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col, Raw row_upper,
                int ch) const;
@@ -138,13 +146,16 @@ class FixedKernels {
   Raw upsample_stored(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col,
                       Raw row_upper, int ch) const;
   bool has_tie(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col, int ch) const;
-  // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd).
+  // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd); linear space: four codes through
+  // the I ROM, result uQ1.F (Rnd).
   Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
-  // lin() of U's encoded output through the interpolated EOTF LUT; uQ1.F.
+  // lin() of U's encoded output through the interpolated EOTF LUT; uQ1.F. Linear space: U's output as it is.
   Raw linear_of_upsampled(Raw upsampled) const;
 
   // Eq. 2: beta = 2 I - L (sQ3.F), shown = clamp(beta, 0, 1), rho = beta - shown.
-  CompensatedSample compensate(Raw full_linear, Raw low_linear) const;
+  CompensatedSample compensate(Raw full_linear, Raw low_linear) const { return split(2 * full_linear - low_linear); }
+  // shown = clamp(beta, 0, 1), rho = beta - shown. A concealed (lost) line of a full frame splits beta = L.
+  CompensatedSample split(Raw beta) const;
   // rho (sQ.F) into the residual store format (its rounding and overflow modes).
   StoredResidual store_residual(Raw rho) const;
 
@@ -182,7 +193,11 @@ class FixedKernels {
  private:
   FixedDecoderConfig config_;
   std::vector<Raw> code_rom_;
-  std::unique_ptr<fx::InterpolatedLut> eotf_;
+  std::unique_ptr<fx::InterpolatedLut> eotf_;  // encoded space only
+  // Linear resample space: D's input lin(E) (uQ1.P) and the re-encoding thresholds T_k (uQ1.P, T_0 = 0).
+  bool linear_space_ = false;
+  std::vector<Raw> resample_rom_;
+  std::vector<Raw> encode_thresholds_;
   std::unique_ptr<fx::InterpolatedLut> reciprocal_;
   std::unique_ptr<fx::InterpolatedLut> exp_fraction_;
   std::vector<Raw> exp_integer_rom_;  // exp(-i), i = 0..15, uQ1.F
@@ -220,6 +235,20 @@ struct EyeState {
   std::int64_t residual_index = 0;
   cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
   cv::Mat previous_low;   // d_t codes with kTieFlag, reduced size, CV_16UC3
+  DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
+                             // view is lost
+};
+
+// A view that arrived with some lines lost (at least one lost, at least one intact), as the reference conceals it:
+// lost lines of a full frame feed D as copies of the nearest intact line above (else below) and show L_t with
+// rho = 0; lost lines of a reduced frame repeat the row of the stored d_{t-1} (substitute) or, without one, the
+// nearest intact line above (else below).
+struct Concealment {
+  std::span<const std::uint8_t> intact;  // one entry per line of the view; 0 = lost
+  int first_intact = 0;  // lost lines above it have no intact line above: they take this line's content
+  int lost_lines = 0;
+  cv::Mat substitute;    // reduced frames: the eye's d_{t-1} frame store (codes with kTieFlag); empty: none
+  bool lost(int y) const { return intact[static_cast<std::size_t>(y)] == 0; }
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.
@@ -228,6 +257,7 @@ struct FrameOutput {
   FrameTally tally;
   bool lcd_held = false;  // LCD: the eye's first frame (no v_{t-1} yet)
   bool full = false;
+  int concealed_lines = 0;
   FixedStageTaps* taps = nullptr;  // test vectors: stage planes to fill (frame-at-a-time schedule only)
 };
 
@@ -242,6 +272,16 @@ class FixedDecoderCore {
 
   // Checks the frame and returns the eye state (reset on a change of view size).
   EyeState& begin(const LinkFrame& frame, const char* who);
+  // Classifies a line mask as the reference does: Whole (empty or every line intact: decode normally), Lost (no
+  // line intact: decode_lost) or Partial, for which `out` is filled. The substitute d_{t-1} is taken when the eye
+  // holds a residual and a d_t of the view's reduced size, looked up before begin() (as the reference does).
+  enum class Arrival { Whole, Partial, Lost };
+  Arrival classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact, Concealment& out,
+                   const char* who);
+  // The codes of a partially received view with every lost line replaced (the frame-at-a-time schedule's form).
+  static cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c);
+  // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
+  DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
   // Allocates the output matrices at full size.
   FrameOutput start_output(const LinkFrame& frame) const;
   // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
@@ -249,9 +289,10 @@ class FixedDecoderCore {
   // Prepares the LCD frame stores of the eye for this frame (first frame: held history).
   void begin_lcd(FrameOutput& out, EyeState& eye) const;
   // One full-frame pixel, all channels (Eq. 2): U of the d_t rows i0/i1 of output row y, L, I from the codes row,
-  // beta, shown (emitted), rho into residual_row.
+  // beta, shown (emitted), rho into residual_row. A lost (concealed) line takes beta = L.
   void full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* codes_row,
-                  const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row) const;
+                  const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row,
+                  bool lost = false) const;
   // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
   // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
   void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
@@ -266,8 +307,8 @@ class FixedDecoderCore {
     p.values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(p.size.width) + static_cast<std::size_t>(x)) *
                  static_cast<std::size_t>(p.channels) + static_cast<std::size_t>(ch)] = value;
   }
-  // Fills FrameStats from the tally and remembers the counts.
-  DecodedFrame finish(FrameOutput&& out, bool full, bool residual_applied);
+  // Fills FrameStats from the tally, remembers the counts and the eye's output.
+  DecodedFrame finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied);
 
  private:
   FixedKernels kernels_;

@@ -43,7 +43,7 @@ cv::Mat drive_16bit(const cv::Mat& drive) {
   return out;
 }
 
-// `trm decode --capture`: replays a recorded packet stream through the receiver into the decoder. The link
+// `trm decode --capture`: replays a recorded packet stream through the receiver into the --impl decoder. The link
 // configuration (r, sigma, transfer, bits, ...) comes from the capture's header; panel, sensitivity and output
 // bits from the command line.
 // Writes frame t's drive_tttt.png (16-bit round(v * 65535)) and driveB_tttt.png (the B-bit codes; 8-bit codes as
@@ -76,7 +76,8 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
   report["link_configuration"] = Json::parse(result.link_configuration);
   report["parameters"] = {{"sensitivity", options.sensitivity},
                           {"panel", options.panel},
-                          {"output_bits", options.output_bits}};
+                          {"output_bits", options.output_bits},
+                          {"impl", options.impl}};
   report["receiver"] = receiver_json(c);
   report["summary"] = {{"views", result.views}, {"concealed_lines", result.concealed_lines}};
   report["frames"] = frames;
@@ -97,7 +98,9 @@ void register_decode(CLI::App& app, Action& action) {
                 "or drive10_*.png) and report.json");
   auto capture = std::make_shared<std::string>();
   options->add_options(*cmd);
-  cmd->add_option("--capture", *capture, "Decode a recorded packet stream (.trmcap) instead of --input")
+  cmd->add_option("--capture", *capture,
+                  "Decode a recorded packet stream (.trmcap) instead of --input, with the --impl decoder (lost lines "
+                  "concealed)")
       ->excludes(cmd->get_option("--input"));
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->required();
   cmd->callback([options, out, capture, &action] {

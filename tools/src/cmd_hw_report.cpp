@@ -30,6 +30,7 @@ void register_hw_report(CLI::App& app, Action& action) {
                               {"reduction", options->encoder.reduction},
                               {"sigma", options->encoder.effective_sigma()},
                               {"panel", options->panel},
+                              {"resample_space", to_string(options->encoder.resample_space)},
                               {"link_bits", options->encoder.bits},
                               {"output_bits", options->output_bits},
                               {"residual_format", config.residual.to_string()},
@@ -42,7 +43,8 @@ void register_hw_report(CLI::App& app, Action& action) {
         dir.commit();
       }
       if (!json->empty()) write_file_atomically(*json, text);
-      std::cout << "trm hw-report: " << options->panel << ", r = " << options->encoder.reduction << ", "
+      std::cout << "trm hw-report: " << options->panel << ", r = " << options->encoder.reduction << " ("
+                << to_string(options->encoder.resample_space) << " resample space), "
                 << options->encoder.bits << "-bit link, " << options->output_bits << "-bit drive, residual "
                 << config.residual.to_string() << "\n"
                 << hardware_summary(report["hardware"]);

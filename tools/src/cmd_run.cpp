@@ -46,15 +46,8 @@ void register_run(CLI::App& app, Action& action) {
   options->add_link_options(*cmd);
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   action = nullptr;
-  cmd->callback([options, out, cmd, &action] {
-    const bool impl_given = cmd->count("--impl") > 0;
-    action = [options, out, impl_given] {
-      const bool faults = options->ber > 0.0 || !options->burst.empty() || options->drop > 0.0;
-      if (faults && !impl_given && options->impl != "reference") {
-        // Concealment of lost lines is modelled in the reference decoder only.
-        std::cerr << "trm: note: link faults requested: decoding with --impl reference (conceals lost lines)\n";
-        options->impl = "reference";
-      }
+  cmd->callback([options, out, &action] {
+    action = [options, out] {
       options->validate();
       warn_refresh(options->refresh_hz);
       const auto start = std::chrono::steady_clock::now();

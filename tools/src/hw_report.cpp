@@ -96,9 +96,11 @@ Json hardware_json(const FixedStreamingReport& r) {
                   {"frame_store_bits", frame_bits},
                   {"off_chip_bits", frame_bits}};
   const std::int64_t saved = r.paper_frame_store_bits - r.model_frame_store_bits;
+  hw["concealment"] = r.concealment;
   hw["paper_comparison"] = {
       {"description", "paper Sec. 9: full-size previous frame (link codes) + full-size residual; this model: "
-                      "reduced-size d_t (codes + tie flag) + full-size residual (LCD stores excluded from both)"},
+                      "reduced-size d_t (codes, + exact-tie flag in the encoded resample space) + full-size residual (LCD stores and the held output for "
+                      "lost views excluded from both)"},
       {"paper_frame_store_bits", r.paper_frame_store_bits},
       {"model_frame_store_bits", r.model_frame_store_bits},
       {"saved_bits", saved},
@@ -150,6 +152,7 @@ std::string hardware_summary(const Json& hw) {
     << "; reduced d_t + residual: " << bits_text(p["model_frame_store_bits"].get<std::int64_t>()) << "; saves "
     << bits_text(p["saved_bits"].get<std::int64_t>()) << " = " << std::fixed << std::setprecision(1)
     << p["saved_percent"].get<double>() << " %\n";
+  if (hw.contains("concealment")) s << "concealment: " << hw["concealment"].get<std::string>() << "\n";
   return s.str();
 }
 

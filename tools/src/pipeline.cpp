@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <span>
 #include <stdexcept>
 
 namespace trm::cli {
@@ -118,7 +119,7 @@ void PipelineOptions::add_options(CLI::App& cmd) {
                  "Fixed-point residual store width N, signed sQ2.(N-2) (default: 26, lossless)");
   cmd.add_option("--impl", impl,
                  "Decoder: reference (double), fixed (fixed-point, line-buffered streaming: the hardware model) or "
-                 "fixed-frame (the same arithmetic frame at a time)")
+                 "fixed-frame (the same arithmetic frame at a time); each conceals lines and views lost on the link")
       ->capture_default_str();
 }
 
@@ -176,10 +177,6 @@ void PipelineOptions::validate() const {
   if (output_bits != 8 && output_bits != 10) throw std::invalid_argument("output bits must be 8 or 10");
   if (impl != "reference" && impl != "fixed" && impl != "fixed-frame") {
     throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference, fixed, fixed-frame)");
-  }
-  if (impl != "reference" && (ber > 0.0 || !burst.empty() || drop > 0.0)) {
-    throw std::invalid_argument("--impl " + impl + " with link faults: concealment of lost lines is modelled in the "
-                                "reference decoder only; use --impl reference");
   }
   (void)parse_panel(panel);
   if (link_enabled()) (void)link_config(width, height);
@@ -243,6 +240,22 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     result.link.emplace();
   }
 
+  // The decoder under test; the reference beside it (compare) sees exactly the same input.
+  const auto decode_whole = [&](const LinkFrame& frame) {
+    if (streaming) return streaming->decode(frame);
+    if (frame_at_a_time) return frame_at_a_time->decode(frame);
+    return decoder.decode(frame);
+  };
+  const auto decode_partial = [&](const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
+    if (streaming) return streaming->decode(frame, line_intact);
+    if (frame_at_a_time) return frame_at_a_time->decode(frame, line_intact);
+    return decoder.decode(frame, line_intact);
+  };
+  const auto decode_lost = [&](const FrameMeta& meta) {
+    if (streaming) return streaming->decode_lost(meta);
+    if (frame_at_a_time) return frame_at_a_time->decode_lost(meta);
+    return decoder.decode_lost(meta);
+  };
   const int eyes = options.encoder.stereo ? 2 : 1;
   std::vector<LinkFrame> sent(static_cast<std::size_t>(eyes));
   std::vector<double> encode_seconds(static_cast<std::size_t>(eyes));
@@ -263,41 +276,41 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       DecodedFrame decoded;
       DecodedFrame reference;
       DecodedFrame free_running_reference;
-      double decode_seconds = -1.0;  // of the decoder under test, not of the reference beside it
-      if (fixed) {
-        const LinkFrame* to_decode = &view_sent;
-        LinkFrame arrived_frame;
-        if (simulation) {
-          // Fault options are rejected with a fixed impl, so every view arrives whole.
-          for (const auto& r : received) {
-            if (r.meta.eye == eye && r.meta.index == t) arrived_frame = LinkFrame{r.meta, r.codes};
-          }
-          if (arrived_frame.codes.empty()) throw std::runtime_error("link lost a view on a fault-free link");
-          to_decode = &arrived_frame;
-        }
-        decoded = streaming ? streaming->decode(*to_decode) : frame_at_a_time->decode(*to_decode);
-        decode_seconds = seconds_since(start);
-        if (compare) {
-          reference = decoder.decode(*to_decode);
-          if (free_running) {
-            decoder.adopt_panel_history(decoded);
-            free_running_reference = free_running->decode(*to_decode);
-          }
-        }
-      } else if (simulation) {
+      double decode_seconds = 0.0;  // of the decoder under test, not of the reference beside it
+      if (simulation) {
         const link::ReceivedFrame* arrived = nullptr;
         for (const auto& r : received) {
           if (r.meta.eye == eye && r.meta.index == t) arrived = &r;
         }
         if (arrived) {
-          decoded = decoder.decode(LinkFrame{arrived->meta, arrived->codes}, arrived->line_intact);
+          const LinkFrame frame{arrived->meta, arrived->codes};
+          decoded = decode_partial(frame, arrived->line_intact);
+          decode_seconds = seconds_since(start);
+          if (compare) {
+            reference = decoder.decode(frame, arrived->line_intact);
+            if (free_running) {
+              decoder.adopt_panel_history(decoded);
+              free_running_reference = free_running->decode(frame, arrived->line_intact);
+            }
+          }
         } else {
-          decoded = decoder.decode_lost(view_sent.meta);
+          decoded = decode_lost(view_sent.meta);
+          decode_seconds = seconds_since(start);
+          if (compare) reference = decoder.decode_lost(view_sent.meta);
+          if (free_running) free_running_reference = free_running->decode_lost(view_sent.meta);
           ++result.link->lost_views;
         }
         result.link->concealed_lines += decoded.stats.concealed_lines;
       } else {
-        decoded = decoder.decode(view_sent);
+        decoded = decode_whole(view_sent);
+        decode_seconds = seconds_since(start);
+        if (compare) {
+          reference = decoder.decode(view_sent);
+          if (free_running) {
+            decoder.adopt_panel_history(decoded);
+            free_running_reference = free_running->decode(view_sent);
+          }
+        }
       }
       DecodedView view;
       view.source = source.get();
@@ -309,7 +322,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       if (fixed) view.fixed_counts = streaming ? &streaming->last_counts() : &frame_at_a_time->last_counts();
       view.render_seconds = render_seconds;
       view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];
-      view.decode_seconds = decode_seconds >= 0.0 ? decode_seconds : seconds_since(start);
+      view.decode_seconds = decode_seconds;
       sink(view);
     }
   }
@@ -329,10 +342,6 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
 CaptureDecodeResult decode_capture_stream(
     const PipelineOptions& options, const std::string& capture_path,
     const std::function<void(const link::ReceivedFrame& received, const DecodedFrame& decoded)>& sink) {
-  if (options.impl != "reference") {
-    throw std::invalid_argument("--capture is decoded by the reference decoder (it conceals lost lines); "
-                                "drop --impl " + options.impl);
-  }
   link::CaptureReplay replay(capture_path);
   nlohmann::json meta;
   try {
@@ -356,12 +365,27 @@ CaptureDecodeResult decode_capture_stream(
   config.panel = parse_panel(options.panel);
   config.output_bits = options.output_bits;
   config.lcd_history = options.lcd_history;
-  ReferenceDecoder decoder(config);
+  // The selected implementation; the fixed-point ones take the capture's link configuration as well.
+  std::optional<ReferenceDecoder> reference;
+  std::optional<FixedStreamingDecoder> streaming;
+  std::optional<FixedFrameDecoder> frame_at_a_time;
+  PipelineOptions fixed_options = options;
+  fixed_options.encoder = config.link;
+  if (options.impl == "fixed") {
+    streaming.emplace(fixed_config_of(fixed_options));
+  } else if (options.impl == "fixed-frame") {
+    frame_at_a_time.emplace(fixed_config_of(fixed_options));
+  } else {
+    reference.emplace(config);
+  }
 
   CaptureDecodeResult result;
   result.link_configuration = meta.dump();
   while (auto received = replay.next_frame()) {
-    const DecodedFrame decoded = decoder.decode(LinkFrame{received->meta, received->codes}, received->line_intact);
+    const LinkFrame frame{received->meta, received->codes};
+    const DecodedFrame decoded = streaming         ? streaming->decode(frame, received->line_intact)
+                                 : frame_at_a_time ? frame_at_a_time->decode(frame, received->line_intact)
+                                                   : reference->decode(frame, received->line_intact);
     result.concealed_lines += decoded.stats.concealed_lines;
     ++result.views;
     sink(*received, decoded);

@@ -99,9 +99,9 @@ struct PipelineResult {
   std::optional<LinkOutcome> link;    // when the link was simulated
 };
 
-// A recorded packet stream (.trmcap) replayed through the receiver into the reference decoder. The link
-// configuration (r, sigma, transfer, bits, ...) comes from the capture's header; panel, sensitivity and output
-// bits from the options. Throws link::CaptureError / std::runtime_error with the file name on a bad capture.
+// A recorded packet stream (.trmcap) replayed through the receiver into the decoder options.impl names (reference,
+// fixed or fixed-frame; each conceals lost lines). The link configuration (r, sigma, transfer, bits, ...) comes from
+// the capture's header; panel, sensitivity, output bits and the fixed-point residual width from the options. Throws link::CaptureError / std::runtime_error with the file name on a bad capture.
 struct CaptureDecodeResult {
   std::string link_configuration;   // the capture header's JSON
   link::ReceiverCounters receiver;

@@ -49,7 +49,8 @@ std::string readme_text(const PipelineOptions& options, const FixedDecoderConfig
     << "Scene `" << options.scene << "`, " << options.width << "x" << options.height << ", r = "
     << options.encoder.reduction << ", " << options.encoder.bits << "-bit link, panel `" << options.panel << "`, "
     << options.output_bits << "-bit drive, s = " << options.sensitivity << ", residual "
-    << config.residual.to_string() << ".\n"
+    << config.residual.to_string() << ", D and U in the " << to_string(options.encoder.resample_space)
+    << " resample space.\n"
     << "Produced by the frame-at-a-time fixed-point decoder (bit-identical to the streaming one).\n\n"
     << "## Format\n\n"
     << "* One file per frame and stage: `frame_NNN_<full|reduced>_<stage>.hex` (`frame_NNN_eyeE_...` in stereo).\n"
@@ -61,7 +62,7 @@ std::string readme_text(const PipelineOptions& options, const FixedDecoderConfig
     << "* `report.json` lists every file with its 64-bit FNV-1a hash (the form checked in under tests/golden/).\n\n"
     << "## Stages\n\n"
     << "| stage | frames | Q format | bits | hex digits | size | what |\n|---|---|---|---|---|---|---|\n";
-  static const std::map<std::string, std::string> what = {
+  std::map<std::string, std::string> what = {
       {"codes", "received link codes E_t (full frames) or i (reduced frames)"},
       {"I", "I = lin(E_t), the code ROM"},
       {"d", "d_t = Q_b(D(E_t)), reduced size, as the frame store holds it (exact half-code tie flag in the top bit)"},
@@ -76,6 +77,15 @@ std::string readme_text(const PipelineOptions& options, const FixedDecoderConfig
       {"alpha_prime", "alpha' = clamp(alpha + w rho, 0, 1) (Eq. 4); clamp(alpha) without a residual"},
       {"drive", "panel drive codes"},
   };
+  if (options.encoder.resample_space == ResampleSpace::Linear) {
+    what["d"] = "d_t = Q_b(enc(D(lin(E_t)))), reduced size: D on linear light (lin(E) ROM in uQ1." +
+                std::to_string(config.linear_resample_frac_bits) + ", taps uQ0." +
+                std::to_string(config.linear_gaussian_tap_frac_bits) +
+                "), re-encoded to link codes by the threshold ROM, as the frame store holds it";
+    what["L"] = "L = U(lin(d_t)), the bilinear U on linear light (lin(d_t) from the I ROM)";
+    what["alpha"] = "alpha = U(lin(i)) (Eq. 1, linear resample space)";
+    what["L_prev"] = "L_{t-1} = U(lin(d_{t-1})) for the motion test";
+  }
   for (const std::string& key : order) {
     const FixedStagePlane& p = stages.at(key);
     const auto frames_of = key.substr(0, key.find(':'));

@@ -21,15 +21,16 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace trm {
 
 struct FixedDecoderConfig {
-  // The algorithm parameters shared with ReferenceDecoder: link (r, sigma, transfer, bits; resample space must be
-  // Encoded), motion sensitivity s, panel, output_bits (8 or 10), lcd_history. record_stages is ignored (no
-  // DecodeStages are filled; FixedFrameDecoder::decode(frame, taps) records the integer stages instead).
+  // The algorithm parameters shared with ReferenceDecoder: link (r, sigma, transfer, bits, resample space), motion
+  // sensitivity s, panel, output_bits (8 or 10), lcd_history. record_stages is ignored (no DecodeStages are filled;
+  // FixedFrameDecoder::decode(frame, taps) records the integer stages instead).
   DecoderConfig decoder;
 
   // Linear light I, L, alpha, shown beta, alpha': uQ1.F (the integer bit holds 1.0 exactly). beta = 2I - L is
@@ -46,11 +47,30 @@ struct FixedDecoderConfig {
   // The horizontal D result as the vertical line buffer holds it: codes uQb.F, rounded half to even (RndConv).
   int gaussian_line_frac_bits = 16;
 
-  // U (bilinear): weights uQ0.F (weight of the lower tap = 2^F - weight of the upper).
+  // D in the linear resample space (link.resample_space == ResampleSpace::Linear, the encoder's Q_b(enc(D(lin(E))))):
+  // lin(E) from a direct ROM per link code in uQ1.P (P = linear_resample_frac_bits), taps uQ0.T (T =
+  // linear_gaussian_tap_frac_bits, summing exactly to 2^T as above), the horizontal result in the line buffer and the
+  // vertical result in uQ1.P (rounded half up). d_t is re-encoded to link codes by a threshold ROM (2^b words of
+  // uQ1.P; T_k is the smallest grid value the encoder's floor(enc(x) (2^b - 1) + 1/2) quantises to k or above) and a
+  // b-step binary search: exactly the encoder's quantiser for every value on the grid, so d_t differs from the
+  // encoder's reduced frame only where D's rounding puts the value on the other side of a threshold. There are no
+  // exact half-code ties to flag (the d_t store holds b-bit codes).
+  // Wider than the encoded space's D formats: in linear light the code steps near black are narrow (gamma 2.2 at 10
+  // bits: 2^-21 between the first thresholds), and a d_t code that differs from the encoder's reads as motion in
+  // Eq. 5. d_t codes differing from the encoder's, over every scene and noise at r in {1, .75, .5, .4, .25}, sRGB and
+  // gamma 2.2 (1,125,720 codes): 8-bit link, P = T = 24: 7 (output still within 1 LSB), P >= 28: 0; 10-bit link,
+  // P = T = 24: 47 (outputs up to 3 LSB off), P = 28, T = 24: 2 (2 LSB), P = 30, T = 26 and P = 32, T = 28: 0 (1 LSB).
+  // The defaults keep two bits of margin over the narrowest that measured exact. P + T <= 62.
+  int linear_resample_frac_bits = 32;
+  int linear_gaussian_tap_frac_bits = 28;
+
+  // U (bilinear): weights uQ0.F (weight of the lower tap = 2^F - weight of the upper). In the linear resample space U
+  // blends lin(d) from the I = lin(E) ROM (uQ1.linear_frac_bits) and its result is linear light uQ1.linear_frac_bits
+  // (rounded half up; no EOTF LUT).
   int bilinear_weight_frac_bits = 16;
-  // U output in code units, uQb.F, rounded (Rnd): the address of the EOTF LUT (b + F <= 24 bits).
+  // U output in code units, uQb.F, rounded (Rnd): the address of the EOTF LUT (b + F <= 24 bits). Encoded space only.
   int upsample_frac_bits = 14;
-  // EOTF LUT after U: uniform segments aligned to link codes, 2^k segments per code step:
+  // EOTF LUT after U (encoded space only): uniform segments aligned to link codes, 2^k segments per code step:
   // (2^b - 1) 2^k + 1 ROM words of uQ1.linear_frac_bits (2041 words at 8 bits). Interpolation error ~h^2/8 |f''|:
   // 4 segments per code leave ~3 linear LSBs (0.09 % of drive codes differ on the line scene), 8 leave < 1.
   int eotf_segments_per_code_log2 = 3;
@@ -145,6 +165,9 @@ struct FixedStreamingReport {
   // formats; and this model's residual plus the reduced-size d_t (the LCD stores, needed by both, left out).
   std::int64_t paper_frame_store_bits = 0;
   std::int64_t model_frame_store_bits = 0;
+  // How lost lines and lost views are concealed in raster order, what that costs beyond the buffers above (the
+  // held-output store, listed with them) and its effect on latency.
+  std::string concealment;
 };
 
 // The integer planes of every stage of one decoded frame, for test vectors (FixedFrameDecoder::decode with taps).
@@ -153,8 +176,9 @@ struct FixedStreamingReport {
 enum class FixedStage {
   Codes,           // received link codes (full size for full frames, reduced size for reduced frames)
   Linear,          // full: I = lin(E_t)
-  Reduced,         // full: d_t = Q_b(D(E_t)) as the frame store holds it (exact-tie flag in bit b)
-  LowPass,         // full: L = lin(U(d_t))
+  Reduced,         // full: d_t = Q_b(D(E_t)) as the frame store holds it (exact-tie flag in bit b; linear space:
+                   // Q_b(enc(D(lin(E_t)))), no flag)
+  LowPass,         // full: L = lin(U(d_t)) (linear space: U(lin(d_t)))
   Beta,            // full: beta = 2 I - L
   Shown,           // full: clamp(beta, 0, 1)
   Residual,        // full: rho (plus any LCD shortfall) in the residual store format
@@ -186,6 +210,7 @@ struct FixedStageTaps {
 
 namespace fixed_detail {
 class FixedDecoderCore;
+struct Concealment;
 }
 
 // Frame-at-a-time schedule.
@@ -201,11 +226,17 @@ class FixedFrameDecoder {
   DecodedFrame decode(const LinkFrame& frame);
   // The same, also filling taps with every stage's integer plane of this frame (the others are not present).
   DecodedFrame decode(const LinkFrame& frame, FixedStageTaps& taps);
+  // As ReferenceDecoder::decode(frame, line_intact): a view received over a faulty link, line_intact holding one
+  // entry per line of frame.codes (0 = lost; empty = none lost), concealed by the reference's rules.
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  // As ReferenceDecoder::decode_lost: the panel holds this eye's previous output (black if none), the residual is
+  // dropped.
+  DecodedFrame decode_lost(const FrameMeta& meta);
   const FixedStageCounts& last_counts() const;
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps);
+  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps, const fixed_detail::Concealment* lost);
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
@@ -218,12 +249,17 @@ class FixedStreamingDecoder {
 
   const FixedDecoderConfig& config() const;
   DecodedFrame decode(const LinkFrame& frame);
+  // Concealment as FixedFrameDecoder (bit-identical), with every lost line replaced as it arrives, in raster order
+  // (see FixedStreamingReport::concealment).
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  DecodedFrame decode_lost(const FrameMeta& meta);
   const FixedStageCounts& last_counts() const;
   // Latency, line buffers / frame stores, ROMs and arithmetic per stage for a view of the given full size.
   FixedStreamingReport report(cv::Size full) const;
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
+  DecodedFrame decode_impl(const LinkFrame& frame, const fixed_detail::Concealment* lost);
 };
 
 }  // namespace trm
