@@ -2,7 +2,7 @@
 // the double reference at the output bit depth (DESIGN §6), and bad configurations are rejected by stage.
 #include "trm/fixed_decoder.hpp"
 
-#include "decoder_test_support.hpp"
+#include "fixed_decoder_test_support.hpp"
 #include "trm/scene.hpp"
 #include "trm/transfer.hpp"
 
@@ -18,80 +18,16 @@
 namespace trm {
 namespace {
 
-FixedDecoderConfig fixed_config(const EncoderConfig& link, const std::string& panel = "vive", int output_bits = 8) {
-  FixedDecoderConfig config;
-  config.decoder.link = link;
-  config.decoder.panel = parse_panel(panel);
-  config.decoder.output_bits = output_bits;
-  return config;
-}
-
-EncoderConfig link_config(double r, int phase = 0, bool stereo = false, int bits = 8) {
-  EncoderConfig link;
-  link.reduction = r;
-  link.phase = phase;
-  link.stereo = stereo;
-  link.bits = bits;
-  return link;
-}
-
-// The link frames (every eye) of `count` frames of a sequence of linear images.
-std::vector<LinkFrame> encode_sequence(const std::vector<cv::Mat>& images, const EncoderConfig& link) {
-  const TrmEncoder encoder(link);
-  std::vector<LinkFrame> frames;
-  for (std::size_t t = 0; t < images.size(); ++t) {
-    for (int eye = 0; eye < (link.stereo ? 2 : 1); ++eye) {
-      frames.push_back(encoder.encode(images[t], static_cast<std::int64_t>(t), eye));
-    }
-  }
-  return frames;
-}
-
-std::vector<cv::Mat> scene_images(const std::string& name, int width, int height, int count) {
-  SceneParams params;
-  params.width = width;
-  params.height = height;
-  params.supersample = 2;
-  auto scene = make_scene(name, params);
-  std::vector<cv::Mat> images;
-  for (int t = 0; t < count; ++t) images.push_back(scene->linear_frame(t));
-  return images;
-}
-
-std::vector<cv::Mat> noise_images(int width, int height, int count, std::uint64_t seed) {
-  std::vector<cv::Mat> images;
-  for (int t = 0; t < count; ++t) images.push_back(test::random_image(width, height, seed + static_cast<std::uint64_t>(t)));
-  return images;
-}
-
-bool identical(const cv::Mat& a, const cv::Mat& b) {
-  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
-}
-
-// Streams the frames through both schedules and requires identical bits in every output and statistic.
-void expect_schedules_identical(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
-                                const std::string& what) {
-  FixedFrameDecoder frame_decoder(config);
-  FixedStreamingDecoder streaming_decoder(config);
-  for (const LinkFrame& link_frame : frames) {
-    const DecodedFrame a = frame_decoder.decode(link_frame);
-    const DecodedFrame b = streaming_decoder.decode(link_frame);
-    const std::string where = what + " t=" + std::to_string(link_frame.meta.index) + " eye=" +
-                              std::to_string(link_frame.meta.eye);
-    ASSERT_TRUE(identical(a.drive_codes, b.drive_codes)) << where;
-    ASSERT_TRUE(identical(a.wanted_linear, b.wanted_linear)) << where;
-    ASSERT_TRUE(identical(a.drive, b.drive)) << where;
-    ASSERT_TRUE(identical(a.emitted_linear, b.emitted_linear)) << where;
-    EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
-    EXPECT_EQ(a.stats.residual_mean_abs, b.stats.residual_mean_abs) << where;
-    EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
-    EXPECT_EQ(a.stats.dropped_sum, b.stats.dropped_sum) << where;
-    EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
-    EXPECT_EQ(a.stats.residual_applied, b.stats.residual_applied) << where;
-    EXPECT_EQ(frame_decoder.last_counts().residual_saturated, streaming_decoder.last_counts().residual_saturated);
-    EXPECT_EQ(frame_decoder.last_counts().alpha_clipped, streaming_decoder.last_counts().alpha_clipped);
-  }
-}
+using test::Agreement;
+using test::compare_with_reference;
+using test::encode_sequence;
+using test::expect_agreement;
+using test::expect_lcd_agreement;
+using test::expect_schedules_identical;
+using test::fixed_config;
+using test::link_config;
+using test::noise_images;
+using test::scene_images;
 
 TEST(FixedDecoder, StreamingMatchesFrameOnEveryScene) {
   for (const std::string& name : scene_names()) {
@@ -139,72 +75,6 @@ TEST(FixedDecoder, StreamingMatchesFrameOnLcd) {
     expect_schedules_identical(encode_sequence(noise_images(size.width, size.height, 4, 5), link), config,
                                "lcd custom contributed");
   }
-}
-
-struct Agreement {
-  std::uint64_t samples = 0;
-  std::uint64_t identical = 0;
-  int max_lsb = 0;
-  double max_merged_codes = 0.0;  // LCD: max |M_fixed - M_reference| (2^o - 1), the merge the eye sees
-  double max_unreachable_difference = 0.0;  // LCD: max per-frame difference of the unreachable fractions
-  double identical_fraction() const { return static_cast<double>(identical) / static_cast<double>(samples); }
-};
-
-Agreement compare_with_reference(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config) {
-  ReferenceDecoder reference(config.decoder);
-  FixedStreamingDecoder fixed(config);
-  Agreement agreement;
-  for (const LinkFrame& frame : frames) {
-    const DecodedFrame expected_frame = reference.decode(frame);
-    const DecodedFrame got_frame = fixed.decode(frame);
-    const cv::Mat& expected = expected_frame.drive_codes;
-    const cv::Mat& got = got_frame.drive_codes;
-    if (config.decoder.panel.kind == PanelKind::Lcd) {
-      agreement.max_unreachable_difference =
-          std::max(agreement.max_unreachable_difference, std::abs(expected_frame.stats.lcd_unreachable_fraction -
-                                                                  got_frame.stats.lcd_unreachable_fraction));
-      cv::Mat merged_expected;
-      cv::Mat merged_got;
-      cv::pow(expected_frame.emitted_linear, 1.0 / config.decoder.panel.lcd.gamma, merged_expected);
-      cv::pow(got_frame.emitted_linear, 1.0 / config.decoder.panel.lcd.gamma, merged_got);
-      agreement.max_merged_codes =
-          std::max(agreement.max_merged_codes, cv::norm(merged_expected, merged_got, cv::NORM_INF) *
-                                                   ((1 << config.decoder.output_bits) - 1));
-    }
-    const cv::Mat e = expected.reshape(1);
-    const cv::Mat g = got.reshape(1);
-    for (int y = 0; y < e.rows; ++y) {
-      for (int k = 0; k < e.cols; ++k) {
-        const int difference = std::abs(static_cast<int>(e.at<std::uint16_t>(y, k)) - g.at<std::uint16_t>(y, k));
-        agreement.identical += difference == 0 ? 1 : 0;
-        agreement.max_lsb = std::max(agreement.max_lsb, difference);
-        ++agreement.samples;
-      }
-    }
-  }
-  return agreement;
-}
-
-void expect_agreement(const Agreement& a, const std::string& what) {
-  std::printf("[ fixed vs reference ] %-28s %9llu codes  identical %8.4f %%  max %d LSB\n", what.c_str(),
-              static_cast<unsigned long long>(a.samples), 100.0 * a.identical_fraction(), a.max_lsb);
-  EXPECT_GE(a.identical_fraction(), 0.999) << what;
-  EXPECT_LE(a.max_lsb, 1) << what;
-}
-
-// LCD: v_t is solved against the code v_{t-1} actually shown, and dv_t/dv_{t-1} is close to -1 (M(v, v) = v), so
-// one code that rounds differently (as in any two implementations) is answered by the opposite difference in the
-// pixel's next frames, without decay. Codes may then differ by a few LSB while the merge M(v_t, v_{t-1}) the eye
-// sees stays within one code; that, and the fraction of identical codes, is what is asserted.
-void expect_lcd_agreement(const Agreement& a, const std::string& what) {
-  std::printf("[ fixed vs reference ] %-32s %9llu codes  identical %8.4f %%  max %d LSB  merge within %.3f codes  "
-              "unreachable fraction within %.4f\n",
-              what.c_str(), static_cast<unsigned long long>(a.samples), 100.0 * a.identical_fraction(), a.max_lsb,
-              a.max_merged_codes, a.max_unreachable_difference);
-  EXPECT_GE(a.identical_fraction(), 0.999) << what;
-  EXPECT_LE(a.max_lsb, 4) << what;
-  EXPECT_LE(a.max_merged_codes, 1.0) << what;
-  EXPECT_LE(a.max_unreachable_difference, 0.002) << what;
 }
 
 TEST(FixedDecoder, AgreesWithReferenceOnEveryScene) {
