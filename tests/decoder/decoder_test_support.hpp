@@ -11,6 +11,9 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace trm::test {
@@ -33,16 +36,19 @@ inline cv::Mat single_bright_pixel(int width, int height, int x, int y) {
   return image;
 }
 
-inline cv::Mat nyquist_checkerboard(int width, int height) {
+// Black and white squares of `cell` pixels; phase 1 swaps the colours.
+inline cv::Mat checkerboard(int width, int height, int cell, int phase = 0) {
   cv::Mat image(height, width, CV_64FC3);
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      const double v = (x + y) % 2 == 0 ? 1.0 : 0.0;
+      const double v = (x / cell + y / cell + phase) % 2 == 0 ? 1.0 : 0.0;
       image.at<cv::Vec3d>(y, x) = cv::Vec3d(v, v, v);
     }
   }
   return image;
 }
+
+inline cv::Mat nyquist_checkerboard(int width, int height) { return checkerboard(width, height, 1); }
 
 // A bright square on a dark background with its top-left corner at (x0, y0).
 inline cv::Mat bright_square(int width, int height, int x0, int y0, int side) {
@@ -85,6 +91,17 @@ inline PairOracle full_frame_oracle(const cv::Mat& full_codes, const EncoderConf
   o.shown = cv::max(cv::min(o.beta, 1.0), 0.0);
   o.residual = o.beta - o.shown;
   return o;
+}
+
+// The message of the std::invalid_argument `action` throws; empty when it throws nothing (any other exception
+// propagates and fails the test).
+inline std::string error_of(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
 }
 
 inline double max_abs_difference(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }

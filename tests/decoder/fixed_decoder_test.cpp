@@ -106,7 +106,8 @@ TEST(FixedDecoder, AgreesWithReferenceOnNoise) {
 // Both ways: synchronised, every LCD code within 1 LSB; free-running, the merge the eye sees within one code.
 void expect_lcd_both_ways(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
                           const std::string& what) {
-  expect_agreement(compare_with_reference(frames, config, whole, LcdComparison::Synchronised), what + " synchronised");
+  expect_agreement(compare_with_reference(frames, config, test::whole, test::LcdComparison::Synchronised),
+                   what + " synchronised");
   expect_lcd_agreement(compare_with_reference(frames, config), what + " free-running");
 }
 

@@ -106,6 +106,31 @@ DecodedFrame decode_as_arrived(Decoder& decoder, const LinkFrame& frame, const A
   return decoder.decode(damaged(frame, arrival.mask), std::span<const std::uint8_t>(arrival.mask));
 }
 
+// One view decoded by both schedules: identical bits in every output, statistic and stage counter. Fatal failures
+// return early (callers looping over frames check HasFatalFailure()).
+inline void expect_identical_outputs(const DecodedFrame& a, const FixedStageCounts& counts_a, const DecodedFrame& b,
+                                     const FixedStageCounts& counts_b, const std::string& where) {
+  ASSERT_TRUE(identical(a.drive_codes, b.drive_codes)) << where;
+  ASSERT_TRUE(identical(a.wanted_linear, b.wanted_linear)) << where;
+  ASSERT_TRUE(identical(a.drive, b.drive)) << where;
+  ASSERT_TRUE(identical(a.emitted_linear, b.emitted_linear)) << where;
+  EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
+  EXPECT_EQ(a.stats.residual_mean_abs, b.stats.residual_mean_abs) << where;
+  EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
+  EXPECT_EQ(a.stats.dropped_sum, b.stats.dropped_sum) << where;
+  EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
+  EXPECT_EQ(a.stats.residual_applied, b.stats.residual_applied) << where;
+  EXPECT_EQ(a.stats.lcd_unreachable_fraction, b.stats.lcd_unreachable_fraction) << where;
+  EXPECT_EQ(a.stats.concealed_lines, b.stats.concealed_lines) << where;
+  EXPECT_EQ(a.stats.frame_lost, b.stats.frame_lost) << where;
+  EXPECT_EQ(counts_a.beta_clipped, counts_b.beta_clipped) << where;
+  EXPECT_EQ(counts_a.residual_saturated, counts_b.residual_saturated) << where;
+  EXPECT_EQ(counts_a.residual_rounded, counts_b.residual_rounded) << where;
+  EXPECT_EQ(counts_a.alpha_clipped, counts_b.alpha_clipped) << where;
+  EXPECT_EQ(counts_a.weight_underflow, counts_b.weight_underflow) << where;
+  EXPECT_EQ(counts_a.lcd_unreachable, counts_b.lcd_unreachable) << where;
+}
+
 // Streams the frames through both schedules and requires identical bits in every output and statistic.
 inline void expect_schedules_identical(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
                                        const std::string& what, const ArrivalPlan& plan = whole) {
@@ -118,20 +143,8 @@ inline void expect_schedules_identical(const std::vector<LinkFrame>& frames, con
     const DecodedFrame b = decode_as_arrived(streaming_decoder, link_frame, arrival);
     const std::string where = what + " t=" + std::to_string(link_frame.meta.index) + " eye=" +
                               std::to_string(link_frame.meta.eye);
-    ASSERT_TRUE(identical(a.drive_codes, b.drive_codes)) << where;
-    ASSERT_TRUE(identical(a.wanted_linear, b.wanted_linear)) << where;
-    ASSERT_TRUE(identical(a.drive, b.drive)) << where;
-    ASSERT_TRUE(identical(a.emitted_linear, b.emitted_linear)) << where;
-    EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
-    EXPECT_EQ(a.stats.residual_mean_abs, b.stats.residual_mean_abs) << where;
-    EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
-    EXPECT_EQ(a.stats.dropped_sum, b.stats.dropped_sum) << where;
-    EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
-    EXPECT_EQ(a.stats.residual_applied, b.stats.residual_applied) << where;
-    EXPECT_EQ(a.stats.concealed_lines, b.stats.concealed_lines) << where;
-    EXPECT_EQ(a.stats.frame_lost, b.stats.frame_lost) << where;
-    EXPECT_EQ(frame_decoder.last_counts().residual_saturated, streaming_decoder.last_counts().residual_saturated);
-    EXPECT_EQ(frame_decoder.last_counts().alpha_clipped, streaming_decoder.last_counts().alpha_clipped);
+    expect_identical_outputs(a, frame_decoder.last_counts(), b, streaming_decoder.last_counts(), where);
+    if (::testing::Test::HasFatalFailure()) return;
   }
 }
 
@@ -143,6 +156,20 @@ struct Agreement {
   double max_unreachable_difference = 0.0;  // LCD: max per-frame difference of the unreachable fractions
   int concealed_lines = 0;        // fixed decoder's count, asserted equal to the reference's view by view
   double identical_fraction() const { return static_cast<double>(identical) / static_cast<double>(samples); }
+
+  // Counts one frame's drive codes (CV_16UC3, same size) against the reference's.
+  void add_codes(const cv::Mat& expected, const cv::Mat& got) {
+    const cv::Mat e = expected.reshape(1);
+    const cv::Mat g = got.reshape(1);
+    for (int y = 0; y < e.rows; ++y) {
+      for (int k = 0; k < e.cols; ++k) {
+        const int difference = std::abs(static_cast<int>(e.at<std::uint16_t>(y, k)) - g.at<std::uint16_t>(y, k));
+        identical += difference == 0 ? 1 : 0;
+        max_lsb = std::max(max_lsb, difference);
+        ++samples;
+      }
+    }
+  }
 };
 
 // LcdComparison::Synchronised hands the reference the fixed decoder's drive codes after every decoded frame
@@ -181,16 +208,7 @@ inline Agreement compare_with_reference(const std::vector<LinkFrame>& frames, co
           std::max(agreement.max_merged_codes, cv::norm(merged_expected, merged_got, cv::NORM_INF) *
                                                    ((1 << config.decoder.output_bits) - 1));
     }
-    const cv::Mat e = expected.reshape(1);
-    const cv::Mat g = got.reshape(1);
-    for (int y = 0; y < e.rows; ++y) {
-      for (int k = 0; k < e.cols; ++k) {
-        const int difference = std::abs(static_cast<int>(e.at<std::uint16_t>(y, k)) - g.at<std::uint16_t>(y, k));
-        agreement.identical += difference == 0 ? 1 : 0;
-        agreement.max_lsb = std::max(agreement.max_lsb, difference);
-        ++agreement.samples;
-      }
-    }
+    agreement.add_codes(expected, got);
   }
   return agreement;
 }

@@ -10,15 +10,7 @@ namespace trm {
 namespace {
 
 using test::decoder_config;
-
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 TEST(DecoderConfig, RejectsInvalidSettings) {
   EncoderConfig link;

@@ -1,0 +1,1034 @@
+// The fixed-point decoders on the DESIGN §7 stiff and extreme cases that apply to the decoder: flat and Nyquist
+// content, maximal over- and undershoot (also through narrow residual stores), r = 1 and tiny r, degenerate and odd
+// sizes, long runs, LCD targets without a root and degenerate merges, s -> 0 and s -> inf, and input that must be
+// rejected. On every case the two schedules agree bit for bit and the streaming decoder agrees with the double
+// reference (DESIGN §6: >= 99.9 % identical codes, the rest within 1 LSB).
+#include "trm/fixed_decoder.hpp"
+
+#include "fixed_decoder_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace trm {
+namespace {
+
+using test::encode_sequence;
+using test::error_of;
+using test::fixed_config;
+using test::link_config;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// ---------------------------------------------------------------------------------------------------------------
+// Running a case: both schedules and the reference in lock step.
+
+struct CaseRun {
+  test::Agreement agreement;  // streaming decoder's drive codes against the reference's
+  double max_residual = 0.0;  // largest max |rho| of any frame (fixed, as stored)
+  FixedStageCounts totals;    // the fixed decoder's stage counters summed over the frames
+  int frames = 0;
+};
+
+// Per-frame check: the link frame, the fixed output and counters, the reference output (empty past the frames the
+// reference is run on).
+using FrameCheck =
+    std::function<void(const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&, const DecodedFrame*)>;
+
+void add_counts(FixedStageCounts& total, const FixedStageCounts& c) {
+  total.beta_clipped += c.beta_clipped;
+  total.residual_saturated += c.residual_saturated;
+  total.residual_rounded += c.residual_rounded;
+  total.alpha_clipped += c.alpha_clipped;
+  total.weight_underflow += c.weight_underflow;
+  total.lcd_unreachable += c.lcd_unreachable;
+}
+
+// Decodes the frames with FixedFrameDecoder and FixedStreamingDecoder (bit-identical, every frame) and, for the
+// first `reference_frames` frames, with the reference (LCD: from the fixed decoder's panel state).
+CaseRun run_case(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config, const std::string& what,
+                 const FrameCheck& check = {}, std::size_t reference_frames = std::numeric_limits<std::size_t>::max()) {
+  FixedFrameDecoder frame_decoder(config);
+  FixedStreamingDecoder streaming_decoder(config);
+  ReferenceDecoder reference(config.decoder);
+  const bool lcd = config.decoder.panel.kind == PanelKind::Lcd;
+  CaseRun run;
+  for (std::size_t n = 0; n < frames.size(); ++n) {
+    const LinkFrame& frame = frames[n];
+    const std::string where =
+        what + " t=" + std::to_string(frame.meta.index) + " eye=" + std::to_string(frame.meta.eye);
+    const DecodedFrame a = frame_decoder.decode(frame);
+    const DecodedFrame b = streaming_decoder.decode(frame);
+    const FixedStageCounts& counts = streaming_decoder.last_counts();
+    test::expect_identical_outputs(a, frame_decoder.last_counts(), b, counts, where);
+    if (::testing::Test::HasFatalFailure()) return run;
+    add_counts(run.totals, counts);
+    run.max_residual = std::max(run.max_residual, b.stats.residual_max_abs);
+    ++run.frames;
+    if (n >= reference_frames) {
+      if (check) check(frame, b, counts, nullptr);
+      continue;
+    }
+    const DecodedFrame expected = reference.decode(frame);
+    run.agreement.add_codes(expected.drive_codes, b.drive_codes);
+    // LCD: the reference continues from the panel state the fixed decoder left (see adopt_panel_history).
+    if (lcd) reference.adopt_panel_history(b);
+    if (check) check(frame, b, counts, &expected);
+  }
+  return run;
+}
+
+// The DESIGN §6 criterion on a run (printed either way).
+void expect_agrees(const CaseRun& run, const std::string& what) {
+  test::expect_agreement(run.agreement, what);
+}
+
+CaseRun expect_case(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config, const std::string& what,
+                    const FrameCheck& check = {}) {
+  CaseRun run = run_case(frames, config, what, check);
+  expect_agrees(run, what);
+  return run;
+}
+
+std::string r_name(double r) { return "r=" + std::to_string(r).substr(0, 4); }
+
+std::string size_name(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
+
+// ---------------------------------------------------------------------------------------------------------------
+// Content.
+
+cv::Mat grey(int width, int height, double v) { return test::flat_image(width, height, cv::Vec3d(v, v, v)); }
+
+// One-pixel line, white on black (or black on white), horizontal at row `at` or vertical at column `at`.
+cv::Mat line_image(int width, int height, int at, bool vertical, bool white_on_black) {
+  cv::Mat image = grey(width, height, white_on_black ? 0.0 : 1.0);
+  const cv::Rect line = vertical ? cv::Rect(at, 0, 1, height) : cv::Rect(0, at, width, 1);
+  image(line & cv::Rect(0, 0, width, height)).setTo(cv::Scalar::all(white_on_black ? 1.0 : 0.0));
+  return image;
+}
+
+// Maximal-contrast edge: white left of column x0 (vertical) or above row x0 (horizontal), black beyond.
+cv::Mat edge_image(int width, int height, int x0, bool vertical) {
+  cv::Mat image = grey(width, height, 0.0);
+  const cv::Rect white = vertical ? cv::Rect(0, 0, x0, height) : cv::Rect(0, 0, width, x0);
+  image(white & cv::Rect(0, 0, width, height)).setTo(cv::Scalar::all(1.0));
+  return image;
+}
+
+std::vector<cv::Mat> repeated(const cv::Mat& image, int count) { return std::vector<cv::Mat>(count, image); }
+
+std::vector<cv::Mat> generated(int count, const std::function<cv::Mat(int)>& frame) {
+  std::vector<cv::Mat> images;
+  for (int t = 0; t < count; ++t) images.push_back(frame(t));
+  return images;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Flat frames.
+
+TEST(FixedExtremes, FlatFramesAreExactAndAgree) {
+  struct Level {
+    std::string name;
+    double linear;
+  };
+  const std::vector<Level> levels = {{"black", 0.0}, {"white", 1.0}, {"grey 0.5 linear", 0.5},
+                                     {"grey code 128", to_linear(128.0 / 255.0, Transfer::Srgb)}};
+  for (const cv::Size size : {cv::Size(16, 12), cv::Size(15, 9)}) {
+    for (double r : {1.0, 0.5, 0.4, 0.25}) {
+      const EncoderConfig link = link_config(r);
+      for (const Level& level : levels) {
+        const std::string what = level.name + " " + size_name(size) + " " + r_name(r);
+        const std::vector<LinkFrame> frames =
+            encode_sequence(repeated(grey(size.width, size.height, level.linear), 4), link);
+        const CaseRun run = expect_case(frames, fixed_config(link), what,
+                                        [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&,
+                                            const DecodedFrame* reference) {
+                                          // Flat in, flat out: no clipping, no residual, one code per channel.
+                                          for (int ch = 0; ch < 3; ++ch) {
+                                            double lo = 0.0;
+                                            double hi = 0.0;
+                                            cv::Mat channel;
+                                            cv::extractChannel(fixed.drive_codes, channel, ch);
+                                            cv::minMaxLoc(channel, &lo, &hi);
+                                            EXPECT_EQ(lo, hi) << what;
+                                          }
+                                          EXPECT_EQ(fixed.stats.residual_max_abs, 0.0) << what;
+                                          if (fixed.stats.residual_applied) {
+                                            EXPECT_EQ(fixed.stats.mean_motion_weight, 1.0) << what;
+                                          }
+                                          ASSERT_NE(reference, nullptr);
+                                          EXPECT_EQ(reference->stats.residual_max_abs, 0.0) << what;
+                                        });
+        EXPECT_EQ(run.totals.beta_clipped + run.totals.alpha_clipped + run.totals.residual_saturated +
+                      run.totals.residual_rounded,
+                  0u)
+            << what;
+      }
+    }
+  }
+}
+
+TEST(FixedExtremes, BlackAndWhiteDriveTheEndCodes) {
+  for (int bits : {8, 10}) {
+    const EncoderConfig link = link_config(0.5, 0, false, bits);
+    const FixedDecoderConfig config = fixed_config(link, "vive", bits);
+    const std::uint16_t top = static_cast<std::uint16_t>((1 << bits) - 1);
+    for (const bool white : {false, true}) {
+      const std::string what = std::string(white ? "white " : "black ") + std::to_string(bits) + "-bit link+drive";
+      expect_case(encode_sequence(repeated(grey(9, 7, white ? 1.0 : 0.0), 2), link), config, what,
+                  [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&, const DecodedFrame*) {
+                    double lo = 0.0;
+                    double hi = 0.0;
+                    cv::minMaxLoc(fixed.drive_codes.reshape(1), &lo, &hi);
+                    EXPECT_EQ(lo, white ? top : 0) << what;
+                    EXPECT_EQ(hi, white ? top : 0) << what;
+                  });
+    }
+  }
+}
+
+TEST(FixedExtremes, FlashesBetweenBlackWhiteAndGrey) {
+  // Every transition between the extremes, hitting full and reduced frames (both phases), stereo included.
+  const std::vector<double> levels = {0.0, 1.0, 0.5, 1.0, 0.0, 0.0, 1.0, 1.0, 0.5, 0.0, 1.0, 0.0};
+  for (double r : {1.0, 0.5, 0.25}) {
+    for (int phase : {0, 1}) {
+      const EncoderConfig link = link_config(r, phase, phase == 1);
+      const std::vector<LinkFrame> frames =
+          encode_sequence(generated(static_cast<int>(levels.size()), [&](int t) { return grey(13, 9, levels[t]); }),
+                          link);
+      expect_case(frames, fixed_config(link), "flash " + r_name(r) + (phase ? " phase 1 stereo" : ""));
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Nyquist checkerboards.
+
+TEST(FixedExtremes, NyquistCheckerboards) {
+  struct Grid {
+    double r;
+    int reduced_cell;  // cell of the checkerboard at the reduced-grid period, ~1/r pixels
+  };
+  for (const Grid grid : {Grid{0.5, 2}, Grid{0.25, 4}, Grid{0.4, 3}}) {
+    for (const cv::Size size : {cv::Size(24, 16), cv::Size(25, 17)}) {
+      const EncoderConfig link = link_config(grid.r);
+      for (int cell : {1, grid.reduced_cell}) {
+        const std::string board = "checker cell " + std::to_string(cell) + " " + size_name(size) + " " + r_name(grid.r);
+        for (int phase : {0, 1}) {
+          // Static: the reduced frame sees c = 0, so w = 1 exactly (also where D lands on an exact half-code tie).
+          const cv::Mat image = test::checkerboard(size.width, size.height, cell, phase);
+          expect_case(encode_sequence(repeated(image, 4), link), fixed_config(link),
+                      board + " phase " + std::to_string(phase),
+                      [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts& counts,
+                          const DecodedFrame* reference) {
+                        if (!fixed.stats.residual_applied) return;
+                        EXPECT_EQ(fixed.stats.mean_motion_weight, 1.0) << board;
+                        EXPECT_EQ(reference->stats.mean_motion_weight, 1.0) << board;
+                        EXPECT_EQ(counts.weight_underflow, 0u);
+                      });
+        }
+        // Counter-phase: the board inverts every frame, the largest change there is. (At r = 0.4 D lands on exact
+        // half-code ties that the encoder's doubles break either way: DISABLED_ExactHalfCodeTiesOfD below.)
+        if (grid.r == 0.4) continue;
+        expect_case(encode_sequence(generated(6, [&](int t) {
+                                      return test::checkerboard(size.width, size.height, cell, t % 2);
+                                    }),
+                                    link),
+                    fixed_config(link), board + " counter-phase");
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// A single bright pixel on black: beta near 2 on the pixel, below 0 around it.
+
+// The residual store's rounding (fx::Quant::Rnd: nearest, ties up) and saturation of one rho sample with F
+// fraction bits: the value it must hold, and whether rho fell outside the range (saturated) or between two
+// representable values (rounded).
+struct StoredRho {
+  std::int64_t value = 0;
+  bool saturated = false;
+  bool rounded = false;
+};
+
+StoredRho store_rho(std::int64_t rho, int linear_frac_bits, const fx::RuntimeFormat& store) {
+  const int shift = linear_frac_bits - store.frac_bits;
+  const std::int64_t nearest = shift == 0 ? rho : (rho + (std::int64_t{1} << (shift - 1))) >> shift;
+  StoredRho out;
+  out.value = std::clamp(nearest, store.min_raw(), store.max_raw());
+  out.saturated = out.value != nearest;
+  out.rounded = !out.saturated && nearest * (std::int64_t{1} << shift) != rho;
+  return out;
+}
+
+struct FullFrameTaps {
+  DecodedFrame frame;
+  FixedStageTaps taps;
+  FixedStageCounts counts;
+};
+
+// The first (full) frame through FixedFrameDecoder with the stage taps (the same bits as without them).
+FullFrameTaps full_frame_taps(const LinkFrame& frame, const FixedDecoderConfig& config) {
+  FixedFrameDecoder decoder(config);
+  FullFrameTaps out;
+  out.frame = decoder.decode(frame, out.taps);
+  out.counts = decoder.last_counts();
+  FixedStreamingDecoder streaming_decoder(config);
+  test::expect_identical_outputs(out.frame, out.counts, streaming_decoder.decode(frame),
+                                 streaming_decoder.last_counts(), "decode with taps");
+  return out;
+}
+
+TEST(FixedExtremes, SingleBrightPixelOvershootAndUndershoot) {
+  struct Spot {
+    cv::Size size;
+    cv::Point at;
+  };
+  for (const Spot spot : {Spot{{16, 16}, {8, 8}}, Spot{{16, 16}, {0, 0}}, Spot{{15, 13}, {14, 6}}}) {
+    for (double r : {1.0, 0.5, 0.4, 0.25}) {
+      const EncoderConfig link = link_config(r);
+      const FixedDecoderConfig config = fixed_config(link);
+      const std::string what = "bright pixel " + size_name(spot.size) + " at (" + std::to_string(spot.at.x) + "," +
+                               std::to_string(spot.at.y) + ") " + r_name(r);
+      const cv::Mat image = test::single_bright_pixel(spot.size.width, spot.size.height, spot.at.x, spot.at.y);
+      const std::vector<LinkFrame> frames = encode_sequence(repeated(image, 4), link);
+
+      const FullFrameTaps full = full_frame_taps(frames[0], config);
+      const FixedStagePlane& beta = full.taps[FixedStage::Beta];
+      const FixedStagePlane& shown = full.taps[FixedStage::Shown];
+      const FixedStagePlane& rho = full.taps[FixedStage::Residual];
+      const double one = std::ldexp(1.0, config.linear_frac_bits);
+      const auto [lowest, highest] = std::minmax_element(beta.values.begin(), beta.values.end());
+      EXPECT_GE(static_cast<double>(*highest) / one, 1.8) << what;  // maximal overshoot: beta = 2 - L
+      EXPECT_LT(*lowest, 0) << what;                                 // undershoot around the pixel: beta = -L
+      // The default store (sQ2.24) holds every rho exactly.
+      EXPECT_EQ(full.counts.residual_saturated, 0u) << what;
+      EXPECT_EQ(full.counts.residual_rounded, 0u) << what;
+      for (std::size_t k = 0; k < rho.values.size(); ++k) {
+        ASSERT_EQ(rho.values[k], beta.values[k] - shown.values[k]) << what << " sample " << k;
+      }
+      const CaseRun run = expect_case(frames, config, what,
+                                      [&](const LinkFrame& frame, const DecodedFrame& fixed, const FixedStageCounts&,
+                                          const DecodedFrame* reference) {
+                                        if (frame.meta.parity != Parity::Full) return;
+                                        EXPECT_NEAR(fixed.stats.residual_max_abs, reference->stats.residual_max_abs,
+                                                    1e-6)
+                                            << what;
+                                      });
+      EXPECT_GE(run.max_residual, 0.8) << what;
+      EXPECT_LE(run.max_residual, 1.0) << what;
+    }
+  }
+  // Moving one pixel per frame: the residual must be held back (w -> 0) where the pixel left.
+  for (double r : {0.5, 0.25}) {
+    const EncoderConfig link = link_config(r);
+    expect_case(encode_sequence(generated(8, [](int t) { return test::single_bright_pixel(17, 11, 3 + t, 5); }), link),
+                fixed_config(link), "moving bright pixel " + r_name(r));
+  }
+}
+
+TEST(FixedExtremes, NarrowResidualStoresCountExactlyTheSamplesOutsideTheirRange) {
+  // rho of a white pixel on black is 0.98 to 0.9995 (from r = 1 to r = 1/4): beyond sQ1.5 (max 0.96875) and mostly
+  // beyond sQ1.7 (max 0.9921875); sQ2.6 holds it rounded, sQ1.23 exactly (unless within half an LSB of 1).
+  for (const fx::RuntimeFormat store : {fx::RuntimeFormat{1, 5, true, fx::Quant::Rnd, fx::Overflow::Sat},
+                                        fx::RuntimeFormat{1, 7, true, fx::Quant::Rnd, fx::Overflow::Sat},
+                                        fx::RuntimeFormat{2, 6, true, fx::Quant::Rnd, fx::Overflow::Sat},
+                                        fx::RuntimeFormat{1, 23, true, fx::Quant::Rnd, fx::Overflow::Sat}}) {
+    for (double r : {1.0, 0.5, 0.25}) {
+      const EncoderConfig link = link_config(r);
+      FixedDecoderConfig config = fixed_config(link);
+      config.residual = store;
+      const std::string what = "bright pixels, store " + store.to_string() + " " + r_name(r);
+      cv::Mat image = test::single_bright_pixel(16, 12, 7, 5);
+      image.at<cv::Vec3d>(0, 0) = cv::Vec3d(1.0, 0.0, 1.0);
+      image.at<cv::Vec3d>(11, 15) = cv::Vec3d(0.0, 1.0, 0.0);
+      const std::vector<LinkFrame> frames = encode_sequence(repeated(image, 4), link);
+
+      const FullFrameTaps full = full_frame_taps(frames[0], config);
+      const FixedStagePlane& beta = full.taps[FixedStage::Beta];
+      const FixedStagePlane& shown = full.taps[FixedStage::Shown];
+      const FixedStagePlane& rho = full.taps[FixedStage::Residual];
+      std::uint64_t saturated = 0;
+      std::uint64_t rounded = 0;
+      for (std::size_t k = 0; k < rho.values.size(); ++k) {
+        const StoredRho expected = store_rho(beta.values[k] - shown.values[k], config.linear_frac_bits, store);
+        ASSERT_EQ(rho.values[k], expected.value) << what << " sample " << k;
+        saturated += expected.saturated ? 1 : 0;
+        rounded += expected.rounded ? 1 : 0;
+      }
+      std::printf("[ residual store ] %-44s saturated %3llu  rounded %3llu of %zu\n", what.c_str(),
+                  static_cast<unsigned long long>(saturated), static_cast<unsigned long long>(rounded),
+                  rho.values.size());
+      EXPECT_EQ(full.counts.residual_saturated, saturated) << what;
+      EXPECT_EQ(full.counts.residual_rounded, rounded) << what;
+      if (store.frac_bits == 5) {
+        EXPECT_GE(saturated, 3u) << what;  // the white pixel's rho >= 0.99
+      }
+      if (store.int_bits == 2 || store.frac_bits == 23) {
+        EXPECT_EQ(saturated, 0u) << what;
+      }
+
+      // Both schedules saturate alike; the full frames (not touched by the store) still agree with the reference.
+      const CaseRun run = run_case(frames, config, what, {}, 1);
+      EXPECT_EQ(run.totals.residual_saturated, 2 * saturated) << what;  // frames 0 and 2
+      expect_agrees(run, what + " full frame");
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Lines and edges.
+
+TEST(FixedExtremes, BrightAndDarkLines) {
+  for (double r : {0.5, 0.4}) {
+    const EncoderConfig link = link_config(r);
+    for (const bool vertical : {false, true}) {
+      for (const bool white_on_black : {true, false}) {
+        const std::string what = std::string(white_on_black ? "white" : "black") +
+                                 (vertical ? " vertical" : " horizontal") + " line " + r_name(r);
+        const CaseRun run = expect_case(
+            encode_sequence(repeated(line_image(24, 16, vertical ? 11 : 7, vertical, white_on_black), 4), link),
+            fixed_config(link), what + " static");
+        EXPECT_GT(run.totals.beta_clipped, 0u) << what;
+        expect_case(encode_sequence(generated(8, [&](int t) {
+                                      return line_image(24, 16, 3 + t, vertical, white_on_black);
+                                    }),
+                                    link),
+                    fixed_config(link), what + " moving");
+      }
+    }
+  }
+}
+
+TEST(FixedExtremes, MaxContrastMovingEdge) {
+  for (double r : {0.5, 0.4}) {
+    const EncoderConfig link = link_config(r);
+    for (int speed : {1, 3}) {
+      for (const bool vertical : {true, false}) {
+        if (r == 0.4 && speed == 1 && !vertical) continue;  // exact ties of D: DISABLED_ExactHalfCodeTiesOfD below
+        const std::string what = std::string(vertical ? "vertical" : "horizontal") + " edge " +
+                                 std::to_string(speed) + " px/frame " + r_name(r);
+        double least_weight = 1.0;
+        expect_case(encode_sequence(generated(10, [&](int t) { return edge_image(32, 24, 4 + speed * t, vertical); }),
+                                    link),
+                    fixed_config(link), what,
+                    [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&, const DecodedFrame*) {
+                      if (!fixed.stats.residual_applied) return;
+                      least_weight = std::min(least_weight, fixed.stats.mean_motion_weight);
+                    });
+        EXPECT_LT(least_weight, 1.0) << what;  // the motion test held some residual back
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// r = 1, tiny r, degenerate and odd sizes.
+
+TEST(FixedExtremes, ReductionOneAndTinyReductions) {
+  struct Case {
+    double r;
+    cv::Size full;
+    cv::Size reduced;
+  };
+  // r = 1: the reduced frame has the full size and D is still the sigma = 1.25 blur. r = 0.05 on 64x48: 3x2
+  // (3.2 and 2.4 round down); r = 0.01: 1x1 (0.64 rounds up, 0.48 is lifted to one pixel).
+  for (const Case c : {Case{1.0, {16, 12}, {16, 12}}, Case{0.05, {64, 48}, {3, 2}}, Case{0.01, {64, 48}, {1, 1}}}) {
+    const EncoderConfig link = link_config(c.r);
+    const int w = c.full.width;
+    const int h = c.full.height;
+    const std::vector<std::pair<std::string, std::vector<cv::Mat>>> contents = {
+        {"noise", test::noise_images(w, h, 4, 900)},
+        {"bright pixel", repeated(test::single_bright_pixel(w, h, w / 2, h / 2), 4)},
+        {"checkerboard", repeated(test::nyquist_checkerboard(w, h), 4)},
+        {"moving edge", generated(6, [&](int t) { return edge_image(w, h, w / 4 + 5 * t, true); })},
+    };
+    for (const auto& [name, images] : contents) {
+      const std::vector<LinkFrame> frames = encode_sequence(images, link);
+      ASSERT_EQ(frames[1].codes.size(), c.reduced) << r_name(c.r);
+      expect_case(frames, fixed_config(link), name + " " + size_name(c.full) + " " + r_name(c.r));
+    }
+  }
+}
+
+TEST(FixedExtremes, DegenerateAndOddSizes) {
+  const std::vector<cv::Size> sizes = {{1, 1}, {1, 7}, {7, 1}, {2, 1}, {1, 2}, {3, 3}, {5, 3}, {13, 7}, {23, 13}};
+  for (const cv::Size size : sizes) {
+    CaseRun total;
+    for (double r : {1.0, 0.75, 0.5, 0.4, 0.25, 0.05}) {
+      // A 2-pixel axis reduced to 1 pixel averages exactly two codes: half-code ties (DISABLED_ExactHalfCodeTiesOfD).
+      if ((size.width == 2 || size.height == 2) && reduced_size(2, r) == 1) continue;
+      const EncoderConfig link = link_config(r, 0, true);  // stereo: both parities in every link frame
+      const std::string what = size_name(size) + " " + r_name(r);
+      const cv::Point spot(size.width / 2, size.height / 2);
+      for (const std::vector<cv::Mat>& images :
+           {test::noise_images(size.width, size.height, 4, 77),
+            repeated(test::single_bright_pixel(size.width, size.height, spot.x, spot.y), 3),
+            generated(4, [&](int t) { return test::checkerboard(size.width, size.height, 1, t % 2); })}) {
+        const CaseRun run = run_case(encode_sequence(images, link), fixed_config(link), what);
+        if (::testing::Test::HasFatalFailure()) return;
+        total.agreement.samples += run.agreement.samples;
+        total.agreement.identical += run.agreement.identical;
+        total.agreement.max_lsb = std::max(total.agreement.max_lsb, run.agreement.max_lsb);
+      }
+    }
+    expect_agrees(total, size_name(size) + " all r, stereo");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Long runs: the residual stays bounded and the output keeps agreeing.
+
+// A 3x3 white square bouncing around the view one pixel per frame in x and y.
+cv::Mat bouncing_square(int width, int height, int t) {
+  const auto bounce = [](int t, int span) {
+    const int p = t % (2 * span);
+    return p < span ? p : 2 * span - p;
+  };
+  cv::Mat image = grey(width, height, 0.02);
+  image(cv::Rect(bounce(t, width - 3), bounce(t, height - 3), 3, 3)).setTo(cv::Scalar::all(1.0));
+  return image;
+}
+
+// A white 4x4 square and a single bright pixel, on for 3 frames of every 7 (so both parities see both states),
+// over a background alternating black and white every 5 frames: periodic with period 70.
+constexpr int kFlashPeriod = 70;
+cv::Mat flashing_square(int width, int height, int t) {
+  cv::Mat image = grey(width, height, (t / 5) % 2 == 0 ? 0.0 : 1.0);
+  if (t % 7 < 3) {
+    image(cv::Rect(2, 2, 4, 4)).setTo(cv::Scalar::all(1.0));
+    image.at<cv::Vec3d>(height - 3, width - 3) = (t / 5) % 2 == 0 ? cv::Vec3d(1, 1, 1) : cv::Vec3d(0, 0, 0);
+  }
+  return image;
+}
+
+// Over a long run: every frame's max |rho| within `bound`, the largest in each half, the saturated samples, and the
+// drive codes of the last two periods (for periodic input).
+struct LongRun {
+  LongRun(int frame_count, double residual_bound) : frames(frame_count), bound(residual_bound) {}
+  int frames;
+  double bound;
+  double max_residual_first_half = 0.0;
+  double max_residual_second_half = 0.0;
+  std::uint64_t saturated = 0;
+  std::vector<cv::Mat> last_codes;
+
+  FrameCheck check(const std::string& what) {
+    return [this, what](const LinkFrame& frame, const DecodedFrame& fixed, const FixedStageCounts& counts,
+                        const DecodedFrame*) {
+      ASSERT_LE(fixed.stats.residual_max_abs, bound) << what << " t=" << frame.meta.index;
+      double& half = frame.meta.index < frames / 2 ? max_residual_first_half : max_residual_second_half;
+      half = std::max(half, fixed.stats.residual_max_abs);
+      saturated += counts.residual_saturated;
+      if (frame.meta.index >= frames - 2 * kFlashPeriod) last_codes.push_back(fixed.drive_codes);
+    };
+  }
+  // The output repeats with the input's period, bit for bit.
+  void expect_periodic(const std::string& what) const {
+    ASSERT_EQ(last_codes.size(), static_cast<std::size_t>(2 * kFlashPeriod)) << what;
+    for (std::size_t t = 0; t < kFlashPeriod; ++t) {
+      ASSERT_TRUE(test::identical(last_codes[t], last_codes[t + kFlashPeriod])) << what << " period offset " << t;
+    }
+  }
+};
+
+TEST(FixedExtremes, LongRunsKeepTheResidualBounded) {
+  constexpr int kFrames = 2000;
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<LinkFrame> flashing =
+      encode_sequence(generated(kFrames, [](int t) { return flashing_square(16, 12, t); }), link);
+  const std::vector<LinkFrame> moving =
+      encode_sequence(generated(kFrames, [](int t) { return bouncing_square(16, 12, t); }), link);
+  const std::string frames = " " + std::to_string(kFrames) + " frames";
+
+  // OLED: |rho| <= 1 by construction (beta = 2 I - L is in [-1, 2]), and the default store never saturates.
+  for (const auto& [name, sequence] :
+       {std::pair{"flashing square", &flashing}, std::pair{"bouncing square", &moving}}) {
+    const std::string what = name + frames;
+    LongRun run(kFrames, 1.0);
+    expect_agrees(run_case(*sequence, fixed_config(link), what, run.check(what)), what);
+    EXPECT_EQ(run.saturated, 0u) << what;
+    std::printf("[ long run ] %-40s max |rho| first half %.6f, second half %.6f\n", what.c_str(),
+                run.max_residual_first_half, run.max_residual_second_half);
+    if (sequence == &flashing) run.expect_periodic(what);
+  }
+
+  // LCD, the flashing square: unreachable targets at both ends in most frames, so rho also carries shortfalls
+  // (|rho| <= 2); the panel history is the one state that lives through the whole run, and it must not drift: the
+  // output is periodic like the input. The reference (a 2^16-entry emission table per frame) joins for 100 frames.
+  const std::string what = "flashing square lcd" + frames;
+  LongRun run(kFrames, 2.0);
+  const CaseRun lcd = run_case(flashing, fixed_config(link, "lcd"), what, run.check(what), 100);
+  expect_agrees(lcd, what + " (first 100)");
+  std::printf("[ long run ] %-40s max |rho| first half %.6f, second half %.6f, %llu unreachable samples\n",
+              what.c_str(), run.max_residual_first_half, run.max_residual_second_half,
+              static_cast<unsigned long long>(lcd.totals.lcd_unreachable));
+  EXPECT_GT(lcd.totals.lcd_unreachable, 0u);
+  run.expect_periodic(what);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// LCD: targets with no root, degenerate and custom merges, the shortfall reaching rho.
+
+TEST(FixedExtremes, LcdUnreachableTargetsAtBothEnds) {
+  // Black -> white (above the brightest merge from v_prev = 0: M(1, 0) = 0.4) and white -> black (below the darkest
+  // from v_prev = 1: M(0, 1) = 0.4), on full frames (phase 0) and reduced frames (phase 1); 10-bit drive once (the
+  // reference tabulates 2^20 merges per 10-bit LCD frame).
+  const std::vector<double> levels = {0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.6, 0.6};
+  for (int bits : {8, 10}) {
+    for (int phase : {0, 1}) {
+      if (bits == 10 && phase == 1) continue;
+      const EncoderConfig link = link_config(0.5, phase);
+      const FixedDecoderConfig config = fixed_config(link, "lcd", bits);
+      const std::string what = "lcd black/white " + std::to_string(bits) + "b phase " + std::to_string(phase);
+      const std::vector<LinkFrame> frames =
+          encode_sequence(generated(bits == 8 ? 12 : 8, [&](int t) { return grey(12, 10, levels[t]); }), link);
+      bool above = false;
+      bool below = false;
+      const CaseRun run = expect_case(
+          frames, config, what,
+          [&](const LinkFrame& frame, const DecodedFrame& fixed, const FixedStageCounts& counts,
+              const DecodedFrame* reference) {
+            if (counts.lcd_unreachable == 0) return;
+            // Flat frames: every sample clamps to the same end.
+            (fixed.drive_codes.at<cv::Vec3w>(0, 0)[1] == 0 ? below : above) = true;
+            const std::int64_t t = frame.meta.index;
+            EXPECT_EQ(fixed.stats.lcd_unreachable_fraction, reference->stats.lcd_unreachable_fraction) << what;
+            if (frame.meta.parity == Parity::Full) {
+              // The shortfall joins rho (beta itself is in [0, 1] for flat content).
+              EXPECT_GT(fixed.stats.residual_max_abs, 0.0) << what << " t=" << t;
+              EXPECT_NEAR(fixed.stats.residual_max_abs, reference->stats.residual_max_abs, 1e-6) << what;
+              EXPECT_NEAR(fixed.stats.residual_mean_abs, reference->stats.residual_mean_abs, 1e-6) << what;
+            }
+          });
+      EXPECT_TRUE(above) << what;
+      EXPECT_TRUE(below) << what;
+      EXPECT_GT(run.totals.lcd_unreachable, 0u) << what;
+    }
+  }
+}
+
+TEST(FixedExtremes, LcdShortfallReachesTheNextReducedFrame) {
+  // Black, then a flat 0.6: the full frame cannot be reached, its shortfall goes into rho, and the static reduced
+  // frame after it carries it (alpha' = alpha + rho > alpha).
+  for (const LcdHistory history : {LcdHistory::Wanted, LcdHistory::Contributed}) {
+    const EncoderConfig link = link_config(0.5);
+    FixedDecoderConfig config = fixed_config(link, "lcd");
+    config.decoder.lcd_history = history;
+    const std::string what = std::string("lcd shortfall ") + (history == LcdHistory::Wanted ? "wanted" : "contributed");
+    const std::vector<LinkFrame> frames =
+        encode_sequence({grey(12, 10, 0.0), grey(12, 10, 0.0), grey(12, 10, 0.6), grey(12, 10, 0.6)}, link);
+    std::vector<DecodedFrame> fixed_frames;
+    expect_case(frames, config, what,
+                [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&, const DecodedFrame*) {
+                  fixed_frames.push_back(fixed);
+                });
+    ASSERT_EQ(fixed_frames.size(), 4u);
+    const DecodedFrame& full = fixed_frames[2];
+    const DecodedFrame& reduced = fixed_frames[3];
+    EXPECT_EQ(full.stats.lcd_unreachable_fraction, 1.0) << what;
+    EXPECT_EQ(full.drive_codes.at<cv::Vec3w>(5, 5)[1], 255) << what;
+    const LcdPanel& lcd = config.decoder.panel.lcd;
+    const double x2 = full.wanted_linear.at<cv::Vec3d>(5, 5)[1];
+    const double shortfall = x2 - 2.0 * std::pow(lcd.p1 + lcd.p3, lcd.gamma);
+    EXPECT_NEAR(full.stats.residual_max_abs, shortfall, 1e-6) << what;
+    EXPECT_TRUE(reduced.stats.residual_applied) << what;
+    EXPECT_NEAR(reduced.wanted_linear.at<cv::Vec3d>(5, 5)[1], x2 + shortfall, 1e-6) << what;
+  }
+}
+
+TEST(FixedExtremes, LcdDegenerateAndCustomMerges) {
+  // p1 = 0: M = (v_t + v_prev) / 2, a linear solve. p1 = 1e-9: numerically linear in the reference, exactly linear
+  // once quantised to sQ7.24 in the fixed decoder. p1 > 0: a convex merge. The custom merge has p4 > 0, so black is
+  // never reachable (M(0, 0) = 0.02).
+  const std::vector<std::string> panels = {"lcd:0,0,0.5,0,2.2", "lcd:1e-9,-2e-9,0.5,0,2.2", "lcd:0.1,-0.2,0.5,0,2.2",
+                                           "lcd:-0.2,0.3,0.6,0.02,2.4", "lcd"};
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<std::pair<std::string, std::vector<cv::Mat>>> contents = {
+      {"noise", test::noise_images(16, 12, 6, 31)},
+      {"flash", generated(6, [](int t) { return grey(16, 12, t % 2 == 0 ? 0.0 : 1.0); })},
+      {"edge", generated(6, [](int t) { return edge_image(16, 12, 2 + 3 * t, true); })},
+      {"black", repeated(grey(16, 12, 0.0), 4)},
+  };
+  for (const std::string& panel : panels) {
+    for (const LcdHistory history : {LcdHistory::Wanted, LcdHistory::Contributed}) {
+      // Contributed history for the custom and the default merge only.
+      if (history == LcdHistory::Contributed && panel != "lcd" && panel != "lcd:-0.2,0.3,0.6,0.02,2.4") continue;
+      FixedDecoderConfig config = fixed_config(link, panel);
+      config.decoder.lcd_history = history;
+      for (const auto& [name, images] : contents) {
+        const std::string what =
+            name + " " + panel + (history == LcdHistory::Wanted ? "" : " contributed");
+        const CaseRun run = expect_case(encode_sequence(images, link), config, what);
+        if (panel == "lcd:-0.2,0.3,0.6,0.02,2.4" && name == "black" && history == LcdHistory::Wanted) {
+          EXPECT_EQ(run.totals.lcd_unreachable, static_cast<std::uint64_t>(4 * 3 * 16 * 12)) << what;
+        }
+      }
+    }
+  }
+  // 10-bit drive, once (the reference tabulates 2^20 merges per 10-bit LCD frame).
+  FixedDecoderConfig ten_bit = fixed_config(link, "lcd:-0.2,0.3,0.6,0.02,2.4", 10);
+  ten_bit.decoder.lcd_history = LcdHistory::Contributed;
+  expect_case(encode_sequence(test::noise_images(16, 12, 4, 37), link), ten_bit, "noise custom lcd 10b contributed");
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Motion sensitivity s -> 0 and s -> inf.
+
+TEST(FixedExtremes, MotionSensitivityExtremes) {
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<std::pair<std::string, std::vector<cv::Mat>>> contents = {
+      {"edge", generated(8, [](int t) { return edge_image(24, 16, 3 + 2 * t, true); })},
+      {"bright pixel", generated(8, [](int t) { return test::single_bright_pixel(24, 16, 4 + t, 7); })},
+      {"noise", test::noise_images(24, 16, 6, 51)},
+      {"discs", test::scene_images("discs", 48, 32, 6)},
+  };
+  // The fixed decoder holds s in uQ8.16: 1e-9 rounds to 0 (w = 1 exactly), 255 is the largest finite s.
+  for (double s : {0.0, 1e-9, 1e-3, 255.0, kInf}) {
+    FixedDecoderConfig config = fixed_config(link);
+    config.decoder.sensitivity = s;
+    CaseRun all;
+    double least_weight = 1.0;
+    double most_weight_difference = 0.0;
+    for (const auto& [name, images] : contents) {
+      const std::string what = name + " s=" + std::to_string(s).substr(0, 8);
+      const CaseRun run = expect_case(
+          encode_sequence(images, link), config, what,
+          [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts& counts,
+              const DecodedFrame* reference) {
+            if (!fixed.stats.residual_applied) return;
+            least_weight = std::min(least_weight, fixed.stats.mean_motion_weight);
+            most_weight_difference = std::max(most_weight_difference, std::abs(fixed.stats.mean_motion_weight -
+                                                                               reference->stats.mean_motion_weight));
+            if (s < 1e-6) {
+              EXPECT_EQ(fixed.stats.mean_motion_weight, 1.0) << what;
+            }
+            if (std::isinf(s)) {
+              EXPECT_EQ(counts.weight_underflow, 0u) << what;  // w = 0 directly, no exp
+            }
+          });
+      all.totals.weight_underflow += run.totals.weight_underflow;
+    }
+    std::printf("[ sensitivity ] s=%-10g least mean w %.6f, mean w within %.2e of the reference, %llu underflows\n", s,
+                least_weight, most_weight_difference, static_cast<unsigned long long>(all.totals.weight_underflow));
+    EXPECT_LE(most_weight_difference, 1e-5) << s;
+    if (s == 255.0) {
+      EXPECT_GT(all.totals.weight_underflow, 0u);  // s c >= 16: w forced to 0
+    }
+    if (s < 1e-6 || std::isinf(s)) {
+      EXPECT_EQ(all.totals.weight_underflow, 0u);
+    }
+    if (s >= 255.0) {
+      EXPECT_LT(least_weight, 0.5) << s;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// NaN, Inf and out-of-range input: rejected with a std::invalid_argument that names the problem.
+
+// Both schedules reject the configuration, naming `fragment`.
+void expect_config_rejected(const FixedDecoderConfig& config, const std::string& fragment, const std::string& what) {
+  const std::string frame_error = error_of([&] { FixedFrameDecoder decoder(config); });
+  const std::string streaming_error = error_of([&] { FixedStreamingDecoder decoder(config); });
+  EXPECT_NE(frame_error.find(fragment), std::string::npos) << what << ": '" << frame_error << "'";
+  EXPECT_NE(streaming_error.find(fragment), std::string::npos) << what << ": '" << streaming_error << "'";
+}
+
+TEST(FixedExtremes, RejectsNanInfAndOutOfRangeConfiguration) {
+  const FixedDecoderConfig good = fixed_config(link_config(0.5));
+  FixedDecoderConfig c = good;
+
+  for (double s : {kNaN, -kInf, -1.0, -1e-300}) {
+    c = good;
+    c.decoder.sensitivity = s;
+    expect_config_rejected(c, "sensitivity", "s=" + std::to_string(s));
+  }
+  for (double s : {255.0 + 1e-9, 256.0, 1e300}) {  // finite s beyond uQ8 (the reference accepts these)
+    c = good;
+    c.decoder.sensitivity = s;
+    expect_config_rejected(c, "motion weight", "s=" + std::to_string(s));
+  }
+  for (double gamma : {kNaN, kInf, -kInf, 0.0, -2.2}) {
+    c = good;
+    c.decoder.panel.oled.gamma[2] = gamma;
+    expect_config_rejected(c, "OLED gammas", "OLED gamma " + std::to_string(gamma));
+  }
+  for (double duty : {kNaN, kInf, 0.0, 1.5}) {
+    c = good;
+    c.decoder.panel.oled.duty = duty;
+    expect_config_rejected(c, "duty", "OLED duty " + std::to_string(duty));
+  }
+  const FixedDecoderConfig lcd = fixed_config(link_config(0.5), "lcd");
+  for (int k = 0; k < 4; ++k) {
+    for (double p : {kNaN, kInf, -kInf}) {
+      c = lcd;
+      double* coefficient[] = {&c.decoder.panel.lcd.p1, &c.decoder.panel.lcd.p2, &c.decoder.panel.lcd.p3,
+                               &c.decoder.panel.lcd.p4};
+      *coefficient[k] = p;
+      const std::string name[] = {"p1", "p2", "p3", "p4"};
+      expect_config_rejected(c, "LCD parameters", name[k] + " = " + std::to_string(p));
+    }
+  }
+  for (double gamma : {kNaN, kInf, 0.0, -1.0}) {
+    c = lcd;
+    c.decoder.panel.lcd.gamma = gamma;
+    expect_config_rejected(c, "LCD gamma", "LCD gamma " + std::to_string(gamma));
+  }
+  c = lcd;
+  c.decoder.panel.lcd.p3 = 1e6;  // finite, but beyond sQ7
+  expect_config_rejected(c, "within [-16, 16]", "p3 = 1e6");
+  c = lcd;
+  c.decoder.panel.lcd.p3 = -0.5;  // M decreasing in v_t: no threshold search
+  expect_config_rejected(c, "increasing", "p3 = -0.5");
+
+  for (double r : {kNaN, kInf, 0.0, -0.5, 1.0 + 1e-12, 2.0}) {
+    c = good;
+    c.decoder.link.reduction = r;
+    expect_config_rejected(c, "reduction r", "r=" + std::to_string(r));
+  }
+  for (double sigma : {kNaN, kInf, -1.0}) {
+    c = good;
+    c.decoder.link.sigma = sigma;
+    expect_config_rejected(c, "sigma", "sigma=" + std::to_string(sigma));
+  }
+  c = good;
+  c.decoder.link.bits = 9;
+  expect_config_rejected(c, "link bits", "link bits 9");
+  c = good;
+  c.decoder.output_bits = 9;
+  expect_config_rejected(c, "output_bits", "output_bits 9");
+}
+
+// What a decoder says about one frame: the std::invalid_argument message (empty: accepted).
+template <typename Decoder>
+std::string frame_error(Decoder& decoder, const LinkFrame& frame) {
+  return error_of([&] { decoder.decode(frame); });
+}
+
+TEST(FixedExtremes, RejectsMalformedFramesAndKeepsWorking) {
+  const EncoderConfig link = link_config(0.5);
+  const FixedDecoderConfig config = fixed_config(link);
+  const std::vector<LinkFrame> good = encode_sequence(test::noise_images(11, 9, 4, 61), link);
+  const LinkFrame& full = good[0];
+  const LinkFrame& reduced = good[1];
+  ASSERT_EQ(reduced.codes.size(), cv::Size(6, 5));
+
+  struct Bad {
+    std::string what;
+    LinkFrame frame;
+    std::string fragment;  // in the fixed decoders' message and the reference's
+  };
+  std::vector<Bad> bad;
+  const auto with_code = [](const LinkFrame& f, int value) {
+    LinkFrame out{f.meta, f.codes.clone()};
+    out.codes.at<cv::Vec3w>(out.codes.rows - 1, out.codes.cols - 1)[2] = static_cast<std::uint16_t>(value);
+    return out;
+  };
+  bad.push_back({"full code 256 on an 8-bit link", with_code(full, 256), "exceeds"});
+  bad.push_back({"reduced code 65535", with_code(reduced, 65535), "exceeds"});
+  {
+    LinkFrame f{full.meta, cv::Mat(full.codes.size(), CV_16UC3, cv::Scalar::all(1023))};
+    f.meta.bits = 10;
+    bad.push_back({"10-bit frame on an 8-bit decoder", f, "link bits"});
+  }
+  {
+    LinkFrame f = full;
+    f.meta.transfer = Transfer::Gamma22;
+    bad.push_back({"other transfer", f, "transfer"});
+  }
+  {
+    LinkFrame f = full;
+    f.meta.eye = -1;
+    bad.push_back({"negative eye", f, "eye"});
+  }
+  for (const cv::Size size : {cv::Size(10, 9), cv::Size(11, 10)}) {
+    LinkFrame f{full.meta, cv::Mat::zeros(size, CV_16UC3)};
+    f.meta.width = size.width;
+    f.meta.height = size.height;
+    bad.push_back({"full frame of " + size_name(size), f, "must be 11x9"});
+  }
+  for (const cv::Size size : {cv::Size(5, 5), cv::Size(6, 4), cv::Size(11, 9), cv::Size(1, 1)}) {
+    LinkFrame f{reduced.meta, cv::Mat::zeros(size, CV_16UC3)};
+    f.meta.width = size.width;
+    f.meta.height = size.height;
+    bad.push_back({"reduced frame of " + size_name(size), f, "must be 6x5"});
+  }
+  for (const cv::Size full_size : {cv::Size(0, 9), cv::Size(11, -1)}) {
+    LinkFrame f = full;
+    f.meta.full_width = full_size.width;
+    f.meta.full_height = full_size.height;
+    bad.push_back({"full size " + size_name(full_size), f, "at least 1x1"});
+  }
+  for (const int type : {CV_16UC1, CV_16UC4, CV_16UC2, CV_8UC3, CV_16SC3, CV_32FC3, CV_64FC3}) {
+    LinkFrame f = full;
+    full.codes.convertTo(f.codes, CV_MAKETYPE(CV_MAT_DEPTH(type), 3));
+    if (CV_MAT_CN(type) != 3) f.codes = cv::Mat::zeros(full.codes.size(), type);
+    bad.push_back({"codes of type " + std::to_string(type), f, "CV_16UC3"});
+  }
+  bad.push_back({"empty codes", LinkFrame{full.meta, cv::Mat()}, "CV_16UC3"});
+
+  FixedFrameDecoder frame_decoder(config);
+  FixedStreamingDecoder streaming_decoder(config);
+  ReferenceDecoder reference(config.decoder);
+  // Interleaved with good frames: a rejected frame leaves the decoder's state as it was.
+  for (const Bad& b : bad) {
+    for (const LinkFrame& g : good) {
+      const DecodedFrame a = frame_decoder.decode(g);
+      const DecodedFrame s = streaming_decoder.decode(g);
+      const DecodedFrame e = reference.decode(g);
+      ASSERT_TRUE(test::identical(a.drive_codes, s.drive_codes)) << "after " << b.what;
+      const std::string error_frame = frame_error(frame_decoder, b.frame);
+      const std::string error_streaming = frame_error(streaming_decoder, b.frame);
+      const std::string error_reference = frame_error(reference, b.frame);
+      EXPECT_NE(error_frame.find(b.fragment), std::string::npos) << b.what << ": '" << error_frame << "'";
+      EXPECT_NE(error_streaming.find(b.fragment), std::string::npos) << b.what << ": '" << error_streaming << "'";
+      EXPECT_NE(error_reference.find(b.fragment), std::string::npos) << b.what << ": '" << error_reference << "'";
+    }
+  }
+  // After every rejection the decoders give what fresh ones give.
+  FixedStreamingDecoder fresh(config);
+  for (const LinkFrame& g : good) {
+    ASSERT_TRUE(test::identical(streaming_decoder.decode(g).drive_codes, fresh.decode(g).drive_codes));
+  }
+}
+
+TEST(FixedExtremes, ViewSizeChangeStartsAfresh) {
+  // A reduced frame that follows a full frame of another view size must not use that residual.
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<LinkFrame> small = encode_sequence(repeated(test::single_bright_pixel(8, 6, 3, 3), 2), link);
+  const std::vector<LinkFrame> large = encode_sequence(repeated(test::single_bright_pixel(16, 12, 7, 7), 2), link);
+  const CaseRun run = expect_case({small[0], large[1], large[0], small[1]}, fixed_config(link), "size change",
+                                  [](const LinkFrame& frame, const DecodedFrame& fixed, const FixedStageCounts&,
+                                     const DecodedFrame* reference) {
+                                    if (frame.meta.parity == Parity::Full) return;
+                                    EXPECT_FALSE(fixed.stats.residual_applied);
+                                    EXPECT_FALSE(reference->stats.residual_applied);
+                                  });
+  EXPECT_EQ(run.frames, 4);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Cases that show decoder bugs (disabled until fixed; see the comments).
+
+// BUG (agreement beyond the DESIGN §6 criterion): exact half-code ties of D. Where D(E_t) is exactly k + 1/2 codes
+// (a 2-pixel axis reduced to 1 averages two codes; content mirror-symmetric about a reduced sample centre: Nyquist
+// checkerboards, an edge midway between two rows), the encoder's double D lands an ulp either side of the half and
+// Q_b rounds it either way, even differently from column to column of a uniform row. The reference takes d_t from
+// the encoder's own function and follows that noise; the fixed decoder computes the tie exactly and has to guess:
+// it rounds half up for L_t and, in the motion test, resolves the tie towards the received reduced code, which is
+// right for static content only. On changing content L_{t-1}, c (Eq. 5) and w rho then differ. Measured:
+//   2x1 stereo, 1-pixel checkerboard inverting every frame, r = 0.05: up to 47 LSB;
+//   1x2 / 2x1 noise and checkerboards at r = 0.5, 0.4, 0.25: 1 LSB (full frames, wherever two codes sum to odd);
+//   24x16 checkerboards (1- and 3-pixel cells) inverting every frame, r = 0.4: 99.65 % identical, 1 LSB;
+//   32x24 horizontal edge moving 1 px/frame, r = 0.4: 99.50 % identical, 1 LSB.
+// Fix (encoder module): make Q_b(D(E)) deterministic at exact ties in reduce_codes (encoder/src/encoder.cpp), e.g.
+// q = floor(x + 1/2 + eps) with x = D(E)(2^b - 1) and eps ~ 1e-9 codes (D's double error is ~1e-13 codes): ties
+// then always round up, as the fixed decoder's gaussian_vertical does, which reproduces d_t bit for bit and no
+// longer needs the tie flag and its resolution (resolve_tie, the tie correction of Eq. 4).
+TEST(FixedExtremes, DISABLED_ExactHalfCodeTiesOfD) {
+  const auto counter_phase = [](cv::Size size, int cell) {
+    return generated(6, [=](int t) { return test::checkerboard(size.width, size.height, cell, t % 2); });
+  };
+  struct Case {
+    std::string what;
+    std::vector<cv::Mat> images;
+    EncoderConfig link;
+  };
+  const std::vector<Case> cases = {
+      {"2x1 counter-phase r=0.05 stereo", counter_phase({2, 1}, 1), link_config(0.05, 0, true)},
+      {"2x1 noise r=0.5 stereo", test::noise_images(2, 1, 4, 77), link_config(0.5, 0, true)},
+      {"1x2 noise r=0.4 stereo", test::noise_images(1, 2, 4, 77), link_config(0.4, 0, true)},
+      {"24x16 counter-phase cell 1 r=0.4", counter_phase({24, 16}, 1), link_config(0.4)},
+      {"24x16 counter-phase cell 3 r=0.4", counter_phase({24, 16}, 3), link_config(0.4)},
+      {"horizontal edge 1 px/frame r=0.4",
+       generated(10, [](int t) { return edge_image(32, 24, 4 + t, false); }), link_config(0.4)},
+  };
+  for (const Case& c : cases) expect_case(encode_sequence(c.images, c.link), fixed_config(c.link), c.what);
+}
+
+// BUG: a frame whose metadata claims a huge view (a wrong size, e.g. a corrupted header) is not rejected before
+// FixedDecoderCore::begin builds (and caches) the geometry of that view: 2 s and ~100 MB at 2,000,000 x 2,000,000,
+// std::bad_alloc (not std::invalid_argument; an abort under ASan) at 2^31 - 1. The reference rejects it at once.
+// Fix: in FixedDecoderCore::begin, check the codes' size against reduced_size(full, r) before kernels_.geometry(full).
+TEST(FixedExtremes, DISABLED_RejectsAHugeClaimedViewBeforeBuildingItsGeometry) {
+  const EncoderConfig link = link_config(0.5);
+  const LinkFrame reduced = encode_sequence(test::noise_images(4, 4, 2, 3), link)[1];
+  LinkFrame huge = reduced;
+  huge.meta.full_width = std::numeric_limits<int>::max();
+  huge.meta.full_height = std::numeric_limits<int>::max();
+  FixedStreamingDecoder decoder(fixed_config(link));
+  EXPECT_NE(frame_error(decoder, huge).find("must be"), std::string::npos);
+  FixedFrameDecoder frame_decoder(fixed_config(link));
+  EXPECT_NE(frame_error(frame_decoder, huge).find("must be"), std::string::npos);
+}
+
+// BUG: a frame whose metadata size disagrees with its codes is rejected, but the fixed decoders' message does not
+// name the problem: meta.width = 10 on 11x9 codes gives "codes are 11x9 but must be 11x9" (the reference says
+// "codes are 11x9 but the metadata says 10x9"). Fix: in FixedDecoderCore::begin, compare frame.codes.size() with
+// (meta.width, meta.height) first and say so, as check_link_frame in reference_decoder.cpp does.
+TEST(FixedExtremes, DISABLED_MetadataSizeMismatchIsNamed) {
+  const EncoderConfig link = link_config(0.5);
+  LinkFrame frame = encode_sequence(test::noise_images(11, 9, 1, 61), link)[0];
+  frame.meta.width = 10;
+  FixedFrameDecoder frame_decoder(fixed_config(link));
+  FixedStreamingDecoder streaming_decoder(fixed_config(link));
+  ReferenceDecoder reference(fixed_config(link).decoder);
+  for (const std::string& error :
+       {frame_error(frame_decoder, frame), frame_error(streaming_decoder, frame), frame_error(reference, frame)}) {
+    EXPECT_NE(error.find("metadata says 10x9"), std::string::npos) << "'" << error << "'";
+  }
+}
+
+// BUG: the residual adjacency test eye.residual_index + 1 == meta.index overflows (UB; UBSan aborts) when a full
+// frame carries index INT64_MAX (fixed_frame_decoder.cpp, fixed_streaming_decoder.cpp; reference_decoder.cpp alike).
+// Fix: reject meta.index < 0 in FixedDecoderCore::begin (as parity_of does on the encoder side) and compare
+// eye.residual_index == meta.index - 1 (no overflow for index >= 0).
+TEST(FixedExtremes, DISABLED_FrameIndexAtTheEndOfItsRange) {
+  const EncoderConfig link = link_config(0.5);
+  std::vector<LinkFrame> frames = encode_sequence(test::noise_images(6, 4, 2, 5), link);
+  frames[0].meta.index = std::numeric_limits<std::int64_t>::max();
+  frames[1].meta.index = 0;
+  FixedStreamingDecoder streaming_decoder(fixed_config(link));
+  FixedFrameDecoder frame_decoder(fixed_config(link));
+  streaming_decoder.decode(frames[0]);
+  frame_decoder.decode(frames[0]);
+  EXPECT_FALSE(streaming_decoder.decode(frames[1]).stats.residual_applied);
+  EXPECT_FALSE(frame_decoder.decode(frames[1]).stats.residual_applied);
+}
+
+// BUG: a user sigma that is positive and finite but degenerate is accepted. sigma = 0.01 at r = 1/2: every
+// Gaussian weight at the half-integer centres underflows to 0 and gaussian_taps (encoder/src/resample.cpp) divides
+// 0 by 0; FixedKernels' integer_weights then converts NaN to an integer (UB; UBSan: signed overflow in its sum) and
+// the decoder shows garbage (the reference throws "quantise: NaN value" only when decoding). sigma = 1e10:
+// gaussian_radius converts 3e10 to int (UB), then std::length_error. Fix: in gaussian_taps, weigh each tap
+// relative to the nearest one, exp(-((i - c)^2 - d_min^2) / 2 sigma^2), so the sum is >= 1 for every sigma > 0;
+// bound sigma in EncoderConfig::validate (e.g. <= 1e4: R = ceil(3 sigma) must fit an int); and have
+// FixedDecoderConfig::validate / integer_weights reject non-finite weights ("D (Gaussian taps)").
+TEST(FixedExtremes, DISABLED_DegenerateGaussianSigma) {
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<LinkFrame> frames = encode_sequence(repeated(grey(6, 4, 0.2), 2), link);
+  for (double sigma : {0.01, 1e10}) {
+    FixedDecoderConfig config = fixed_config(link);
+    config.decoder.link.sigma = sigma;
+    const std::string error = error_of([&] {
+      FixedStreamingDecoder decoder(config);
+      decoder.decode(frames[0]);
+      decoder.decode(frames[1]);
+    });
+    EXPECT_NE(error.find("sigma"), std::string::npos) << "sigma=" << sigma << ": '" << error << "'";
+  }
+}
+
+}  // namespace
+}  // namespace trm
