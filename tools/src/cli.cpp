@@ -22,6 +22,7 @@ int run_main(int argc, char** argv) {
   register_feed(app, action);
   register_hw_report(app, action);
   register_vectors(app, action);
+  register_sweep(app, action);
 
   try {
     app.parse(argc, argv);

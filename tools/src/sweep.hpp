@@ -1,0 +1,133 @@
+// `trm sweep` (DESIGN §7, error against run time): every approximation knob of the fixed-point decoder swept alone
+// around the base configuration (the default formats plus the shared options), each point decoding the same encoded
+// sequence with the streaming decoder and held to the double-precision reference: output-code and linear-light error,
+// decode time per frame, and the on-chip / off-chip memory of FixedStreamingDecoder::report().
+#pragma once
+
+#include "pipeline.hpp"
+
+#include "trm/fixed_decoder.hpp"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace trm::cli {
+
+using Json = nlohmann::ordered_json;
+
+// One approximation knob: an integer field (or derived width) of FixedDecoderConfig.
+struct SweepKnob {
+  std::string name;         // as --knob takes it, e.g. "residual_bits"
+  std::string description;  // what it sets
+  std::string cost;         // where it costs: "off chip", "on chip (ROM)", "arithmetic width only", ...
+  std::vector<int> values;  // the default sweep range (the base value is always added)
+  bool oled = true;         // used with an OLED panel
+  bool lcd = true;          // used with the LCD panel
+  std::function<int(const FixedDecoderConfig&)> get;
+  // Sets the knob on a copy of the base configuration; may throw std::invalid_argument (the point is rejected).
+  std::function<void(FixedDecoderConfig&, int)> set;
+};
+
+// Every knob, in pipeline order.
+const std::vector<SweepKnob>& sweep_knobs();
+// The knob called name, or nullptr.
+const SweepKnob* find_sweep_knob(const std::string& name);
+
+struct SweepOptions {
+  PipelineOptions pipeline;           // scene / input, size, frames, r, panel, bits, ...; impl is ignored
+  std::vector<std::string> knobs;     // empty: every knob the panel uses
+  std::vector<int> values;            // replaces the default range (only with exactly one knob)
+  int repeats = 5;                    // decode time: median per view over this many decodes of the sequence
+  cv::Size hw_size{1080, 1200};       // view size the memory figures are reported for
+  std::string command;                // the command line that reproduces the run (for the reports)
+
+  // Throws std::invalid_argument with one clear message: unknown knob (listing the known ones), --values without
+  // exactly one knob, repeats < 1, and everything PipelineOptions::validate() rejects.
+  void validate() const;
+};
+
+// The acceptance criterion of DESIGN §6 applied to each point.
+inline constexpr double kSweepIdenticalPercent = 99.9;
+inline constexpr double kSweepMaxLsb = 1.0;
+
+struct SweepPoint {
+  int value = 0;
+  bool is_default = false;
+  std::string status = "ok";          // ok | rejected (validate() refused the configuration) | failed (decode threw)
+  std::string message;                // why, when not ok
+  // Output drive codes against the reference's, rounded to the output depth.
+  std::int64_t codes = 0;
+  std::int64_t differing = 0;
+  double identical_percent = 0.0;
+  double max_lsb = 0.0;
+  double mean_lsb = 0.0;
+  double rms_lsb = 0.0;
+  // Emitted linear light (panel model of the quantised drive) against the reference's.
+  double linear_max = 0.0;
+  double linear_rms = 0.0;
+  // Drive value v before output quantisation (DecodedFrame::drive), in output LSB.
+  double drive_max_lsb = 0.0;
+  std::uint64_t residual_saturated = 0;  // rho samples saturated / rounded by the residual store, all frames
+  std::uint64_t residual_rounded = 0;
+  // Run time: decode wall seconds per view (each view's median over the repeats, averaged over the views), each
+  // repeat's figure, and construction (ROMs).
+  double seconds_per_frame = 0.0;
+  double min_seconds_per_frame = 0.0;  // the same with each view's fastest decode (least disturbed by other load)
+  std::vector<double> repeat_seconds_per_frame;
+  double setup_seconds = 0.0;
+  // Memory at SweepOptions::hw_size: line buffers + ROMs, frame stores, and the change against the base point.
+  std::int64_t on_chip_bits = 0;
+  std::int64_t off_chip_bits = 0;
+  std::int64_t delta_on_chip_bits = 0;
+  std::int64_t delta_off_chip_bits = 0;
+  std::string residual_format;        // the residual store of this point (it follows linear_frac_bits)
+
+  bool ok() const { return status == "ok"; }
+  bool meets_criterion() const {
+    return ok() && identical_percent >= kSweepIdenticalPercent && max_lsb <= kSweepMaxLsb;
+  }
+};
+
+struct SweepKnobResult {
+  const SweepKnob* knob = nullptr;
+  int default_value = 0;
+  std::string skipped;                // non-empty: the knob does not apply (the reason)
+  std::vector<SweepPoint> points;     // ascending value
+  // The smallest value at and above which every accepted point meets the criterion (nullptr: the most precise
+  // accepted value fails it). Every knob costs the same or more as it grows.
+  const SweepPoint* cheapest_meeting() const;
+};
+
+struct SweepResult {
+  SweepOptions options;
+  cv::Size size;                      // decoded view size
+  cv::Size reduced;
+  std::int64_t views = 0;             // decoded views per point
+  double reference_seconds_per_frame = 0.0;
+  SweepPoint base;                    // every knob at its base value
+  std::vector<SweepKnobResult> knobs;
+  double wall_seconds = 0.0;
+};
+
+// Encodes the sequence once, decodes it once with the reference, then once per sweep point (repeats times) with
+// FixedStreamingDecoder. progress(done, total) is called after every decode of the sequence.
+SweepResult run_sweep(const SweepOptions& options,
+                      const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
+
+// sweep.csv: a header and one row per knob x value.
+std::string sweep_csv(const SweepResult& result);
+// sweep.md: parameters, a summary per knob, then one table per knob (the base value marked).
+std::string sweep_markdown(const SweepResult& result);
+// report.json: parameters, base configuration and every point.
+Json sweep_json(const SweepResult& result);
+// sweep_<knob>.png: error against knob value, against memory and against decode time (RGB).
+cv::Mat sweep_plot(const SweepResult& result, const SweepKnobResult& knob);
+// The short table printed to stdout: per knob, the base point and the cheapest point meeting the criterion.
+std::string sweep_summary(const SweepResult& result);
+
+}  // namespace trm::cli
