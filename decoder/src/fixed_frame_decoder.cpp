@@ -40,6 +40,20 @@ cv::Mat reduce_whole_frame(const fixed_detail::FixedKernels& kernels, const Geom
   return low;
 }
 
+// The static-skip line comparator (DESIGN §7) over every reduced row: row k of the received (concealed) codes against
+// the stored d_{t-1} row k. Rows above the first intact line of a view without a d_{t-1} substitute are not compared
+// (the streaming schedule never holds them), so they never skip.
+std::vector<std::uint8_t> compare_lines(const cv::Mat& codes, const cv::Mat& previous_low,
+                                        const fixed_detail::Concealment* lost) {
+  const int first = lost != nullptr && lost->substitute.empty() ? lost->first_intact : 0;
+  std::vector<std::uint8_t> flags(static_cast<std::size_t>(codes.rows), 0);
+  for (int k = first; k < codes.rows; ++k) {
+    flags[static_cast<std::size_t>(k)] = fixed_detail::FixedKernels::compare_line(
+        previous_low.ptr<std::uint16_t>(k), codes.ptr<std::uint16_t>(k), 3 * codes.cols);
+  }
+  return flags;
+}
+
 }  // namespace
 
 FixedFrameDecoder::FixedFrameDecoder(FixedDecoderConfig config)
@@ -124,6 +138,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
         core_->full_pixel(out, eye, g, y, x, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
                           residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y));
       }
+      core_->end_full_line(out, eye, y, residual.ptr<std::int32_t>(y));
     }
     eye.have_residual = true;
     eye.residual_index = frame.meta.index;
@@ -133,8 +148,23 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
   }
 
   const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
+  const bool gated = residual_applies && core_->skipping();
+  const std::vector<std::uint8_t> line_flags = gated ? compare_lines(frame.codes, eye.previous_low, lost)
+                                                     : std::vector<std::uint8_t>();
   for (int y = 0; y < g.full.height; ++y) {
     const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    if (gated) {
+      const fixed_detail::ReducedLineGate gate = core_->reduced_line_gate(
+          out, eye, g, y, [&](int k) { return line_flags[static_cast<std::size_t>(k)]; });
+      const bool read_previous = !gate.motion_static || gate.tie_rows;
+      for (int x = 0; x < g.full.width; ++x) {
+        core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
+                             read_previous ? row_of(eye.previous_low, row.i0) : nullptr,
+                             read_previous ? row_of(eye.previous_low, row.i1) : nullptr,
+                             gate.residual_zero ? nullptr : eye.residual.ptr<std::int32_t>(y), &gate);
+      }
+      continue;
+    }
     for (int x = 0; x < g.full.width; ++x) {
       if (residual_applies) {
         core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),

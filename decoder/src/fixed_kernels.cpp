@@ -606,6 +606,23 @@ WeightedSample FixedKernels::add_weighted_residual(Raw alpha, Raw weight, Raw re
   return out;
 }
 
+WeightedSample FixedKernels::clamp_alpha(Raw alpha) const {
+  WeightedSample out;
+  out.alpha_prime = std::clamp(alpha, Raw{0}, one());
+  out.clipped = out.alpha_prime != alpha;
+  out.dropped = alpha > out.alpha_prime ? alpha - out.alpha_prime : out.alpha_prime - alpha;
+  return out;
+}
+
+std::uint8_t FixedKernels::compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples) {
+  std::uint8_t flags = kLineStatic;
+  for (int i = 0; i < samples; ++i) {
+    if (resolve_tie(stored[i], received[i]) != received[i]) return 0;
+    if (code_of(stored[i]) != received[i]) flags |= kLineTie;
+  }
+  return flags;
+}
+
 std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
   // Binary search over the threshold ROM: o comparisons per sample.
   const std::vector<Raw>& t = thresholds_[static_cast<std::size_t>(ch)];
@@ -873,9 +890,21 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometr
   }
 }
 
+void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const {
+  if (!skipping()) return;
+  const int height = eye.full_size.height;
+  if (y == 0) eye.residual_nonzero.assign(static_cast<std::size_t>(height), 0);
+  // The OR of the line's residual samples, accumulated as they are produced (one flip-flop) and kept as the line's
+  // flag: a line held all zero is not written to the store.
+  const int samples = 3 * eye.full_size.width;
+  const bool nonzero = std::any_of(residual_row, residual_row + samples, [](std::int32_t v) { return v != 0; });
+  eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
+  out.tally.counts.residual_write_lines_skipped += nonzero ? 0 : 1;
+}
+
 void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
                                      const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                                     const std::int32_t* residual_row) const {
+                                     const std::int32_t* residual_row, const ReducedLineGate* gate) const {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
   Raw alpha[3];
@@ -883,7 +912,9 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
     alpha[ch] = kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
     tap(out, FixedStage::Alpha, y, x, ch, alpha[ch]);
   }
-  if (residual_row == nullptr) {
+  const bool motion_static = gate != nullptr && gate->motion_static;
+  const bool residual_zero = gate != nullptr && gate->residual_zero;
+  if (residual_row == nullptr && !residual_zero) {
     // No full frame just before: alpha alone (U of codes stays within [0, 1]; the clamp only guards).
     for (int ch = 0; ch < 3; ++ch) {
       const Raw shown = std::clamp(alpha[ch], Raw{0}, kernels_.one());
@@ -898,15 +929,19 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   Raw previous[3];
   Raw tie_correction[3] = {0, 0, 0};
   for (int ch = 0; ch < 3; ++ch) {
-    previous[ch] = kernels_.linear_of_upsampled(kernels_.upsample_previous(prev0, prev1, in0, in1, col, row.upper, ch));
-    if (kernels_.has_tie(prev0, prev1, col, ch)) {
+    // Static line (DESIGN §7): the resolved d_{t-1} rows equal the received ones, so U of them is alpha.
+    previous[ch] = motion_static ? alpha[ch]
+                                 : kernels_.linear_of_upsampled(
+                                       kernels_.upsample_previous(prev0, prev1, in0, in1, col, row.upper, ch));
+    if ((!motion_static || gate->tie_rows) && kernels_.has_tie(prev0, prev1, col, ch)) {
       tie_correction[ch] = kernels_.linear_of_upsampled(kernels_.upsample_stored(prev0, prev1, col, row.upper, ch)) -
                            previous[ch];
     }
   }
   FrameTally& t = out.tally;
   bool underflow = false;
-  const Raw weight = kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);  // Eqs. 5-6
+  const Raw weight = motion_static ? kernels_.one()  // c = 0: w = 1 exactly (DESIGN §4)
+                                   : kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);
   if (out.taps != nullptr) {
     for (int ch = 0; ch < 3; ++ch) tap(out, FixedStage::PreviousLowPass, y, x, ch, previous[ch]);
     tap(out, FixedStage::Contrast, y, x, 0, kernels_.motion_contrast(kernels_.luma(previous), kernels_.luma(alpha)));
@@ -915,8 +950,10 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   t.weight_sum += weight;
   t.counts.weight_underflow += underflow ? 1 : 0;
   for (int ch = 0; ch < 3; ++ch) {
-    const Raw residual = residual_row[3 * x + ch];
-    const WeightedSample s = kernels_.add_weighted_residual(alpha[ch], weight, residual, tie_correction[ch]);  // Eq. 4
+    const Raw residual = residual_zero ? 0 : residual_row[3 * x + ch];
+    const WeightedSample s = residual_zero && tie_correction[ch] == 0
+                                 ? kernels_.clamp_alpha(alpha[ch])
+                                 : kernels_.add_weighted_residual(alpha[ch], weight, residual, tie_correction[ch]);  // Eq. 4
     t.clipped += s.clipped ? 1 : 0;
     t.counts.alpha_clipped += s.clipped ? 1 : 0;
     t.dropped_sum += s.dropped;

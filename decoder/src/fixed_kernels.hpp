@@ -173,6 +173,17 @@ class FixedKernels {
   Raw motion_contrast(Raw luma_previous, Raw luma_alpha) const;
   // Eq. 4: alpha' = clamp(alpha + w (rho + tie_correction), 0, 1); tie_correction = L_used - L_resolved (uQ.F).
   WeightedSample add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const;
+  // Eq. 4 on a line with no residual (DESIGN §7 skip): alpha' = clamp(alpha, 0, 1), what add_weighted_residual gives
+  // for rho = 0 and no tie correction.
+  WeightedSample clamp_alpha(Raw alpha) const;
+
+  // The line comparator of the static skip (DESIGN §7): a received reduced line i(k) against the stored d_{t-1} row
+  // k, `samples` channel samples. kLineStatic: every code equals the stored one with its exact tie resolved towards
+  // the received code (so U of the two is the same); kLineTie: some stored code differs from the received one only
+  // by that tie resolution (the tie correction of Eq. 4 is not zero there).
+  static constexpr std::uint8_t kLineStatic = 1;
+  static constexpr std::uint8_t kLineTie = 2;
+  static std::uint8_t compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples);
 
   // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
   std::uint16_t drive_code(Raw linear, int ch) const;
@@ -235,6 +246,7 @@ struct EyeState {
   std::int64_t residual_index = 0;
   cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
   cv::Mat previous_low;   // d_t codes with kTieFlag, reduced size, CV_16UC3
+  std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
   DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
                              // view is lost
 };
@@ -249,6 +261,14 @@ struct Concealment {
   int lost_lines = 0;
   cv::Mat substitute;    // reduced frames: the eye's d_{t-1} frame store (codes with kTieFlag); empty: none
   bool lost(int y) const { return intact[static_cast<std::size_t>(y)] == 0; }
+};
+
+// The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
+// flags of its U source rows and the full frame's residual line flag.
+struct ReducedLineGate {
+  bool motion_static = false;  // L_{t-1} = alpha on the whole line: w = 1, no motion test
+  bool tie_rows = false;       // static, but a source row's tie makes the tie correction nonzero somewhere
+  bool residual_zero = false;  // rho all zero on the line: no residual read, no add
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.
@@ -295,9 +315,34 @@ class FixedDecoderCore {
                   bool lost = false) const;
   // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
   // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
+  // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are read only when
+  // tie_rows); residual_zero reads no residual (residual_row may then be null) and adds nothing.
   void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
                      const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                     const std::int32_t* residual_row) const;
+                     const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr) const;
+  // DESIGN §7 skips (no-ops unless config().skip_unneeded):
+  // after full-frame output line y: flags the line of the residual store whose rho is not all zero (the write
+  // gate), counting the lines not written;
+  void end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const;
+  bool skipping() const { return config().skip_unneeded; }
+  // the gate of reduced-frame output line y from the comparator flags of its source rows (row_flags(k) gives row k's
+  // FixedKernels::compare_line result), counting the skip events.
+  template <typename RowFlags>
+  ReducedLineGate reduced_line_gate(FrameOutput& out, const EyeState& eye, const Geometry& g, int y,
+                                    RowFlags row_flags) const {
+    const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    const std::uint8_t f0 = row_flags(row.i0);
+    // With a lower-row weight of 0, U reads the upper row alone (bilinear blend, exactly).
+    const std::uint8_t f1 = row.upper == 0 ? static_cast<std::uint8_t>(FixedKernels::kLineStatic) : row_flags(row.i1);
+    ReducedLineGate gate;
+    gate.motion_static = (f0 & f1 & FixedKernels::kLineStatic) != 0;
+    gate.tie_rows = gate.motion_static && ((f0 | (row.upper == 0 ? 0 : f1)) & FixedKernels::kLineTie) != 0;
+    gate.residual_zero = eye.residual_nonzero.size() == static_cast<std::size_t>(g.full.height) &&
+                         eye.residual_nonzero[static_cast<std::size_t>(y)] == 0;
+    out.tally.counts.motion_test_lines_skipped += gate.motion_static ? 1 : 0;
+    out.tally.counts.residual_read_lines_skipped += gate.residual_zero ? 1 : 0;
+    return gate;
+  }
   // Test vectors: marks the stages of this frame kind present in taps, sized and formatted, and attaches them.
   void start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full, bool residual) const;
   // Records one value of a stage plane (no-op without taps).

@@ -184,6 +184,24 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
     add_frame_store("frame: held output (drive codes, re-shown when a view is lost)", g.full.height,
                     3 * g.full.width, c.decoder.output_bits);
   }
+  if (c.skip_unneeded) {
+    // DESIGN §7 skips: the line comparator's static / tie flags beside the U buffer of i, and one residual-nonzero
+    // bit per full line (the only storage the skips add; OLED already keeps no LCD stores).
+    add_frame_store("line: U of i comparator flags (static, exact tie) vs d_{t-1}", p.reduced_lines, 1, 2);
+    add_frame_store("frame: residual-nonzero line flags (rho write / read gate)", g.full.height, 1, 1);
+    FixedArithmeticReport& compare = r.arithmetic.emplace_back();
+    compare.stage = "line comparator i vs d_{t-1} (static skip)";
+    compare.frame = "reduced";
+    compare.evaluated_per = "reduced sample";
+    compare.evaluations = reduced_samples;
+    compare.comparators = low_bits == b ? 1 : 2;
+    FixedArithmeticReport& nonzero = r.arithmetic.emplace_back();
+    nonzero.stage = "residual-nonzero OR (residual skip)";
+    nonzero.frame = "full";
+    nonzero.evaluated_per = "channel sample";
+    nonzero.evaluations = full_samples;
+    nonzero.comparators = 1;
+  }
   r.concealment = std::string(
       "lost lines are replaced as they arrive, without extra line buffers: a lost line below an intact one repeats "
       "the concealed line above it from the input ring (E_t delay on full frames, U of i on reduced frames); lost "
@@ -298,6 +316,7 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
           for (int x = 0; x < g.full.width; ++x) {
             core_->full_pixel(out, eye, g, y, x, codes_row, low0, low1, residual_row, lost_line);
           }
+          core_->end_full_line(out, eye, y, residual_row);
         },
         first);
     eye.have_residual = true;
@@ -309,6 +328,9 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
 
   const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
   LineRing<std::uint16_t> in_lines("U of i", plan.reduced_lines, reduced_samples);
+  // DESIGN §7 static skip: the line comparator's result for each line held in the U buffer (2 bits per line).
+  const bool gated = residual_applies && core_->skipping();
+  LineRing<std::uint8_t> line_flags("U of i comparator flags", plan.reduced_lines, 1);
   reduced_frame_schedule(
       g,
       [&](int k) {
@@ -323,16 +345,29 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
         } else {
           repeat_line(in_lines, k, reduced_samples);
         }
+        if (gated) {  // compared as the line enters the U buffer, against the d_{t-1} frame store row k
+          *line_flags.write(k) = fixed_detail::FixedKernels::compare_line(eye.previous_low.ptr<std::uint16_t>(k),
+                                                                          in_lines.read(k), reduced_samples);
+        }
       },
       [&](int y, int) {
         const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
         const std::uint16_t* in0 = in_lines.read(source_line(row.i0));
         const std::uint16_t* in1 = in_lines.read(source_line(row.i1));
-        const std::uint16_t* prev0 = residual_applies ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
-        const std::uint16_t* prev1 = residual_applies ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
-        const std::int32_t* residual_row = residual_applies ? eye.residual.ptr<std::int32_t>(y) : nullptr;
+        fixed_detail::ReducedLineGate gate;
+        if (gated) {
+          // Lines above `first` (never held) do not skip.
+          gate = core_->reduced_line_gate(out, eye, g, y, [&](int k) -> std::uint8_t {
+            return k < first ? 0 : *line_flags.read(k);
+          });
+        }
+        const bool read_previous = residual_applies && (!gate.motion_static || gate.tie_rows);
+        const std::uint16_t* prev0 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
+        const std::uint16_t* prev1 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
+        const std::int32_t* residual_row =
+            residual_applies && !gate.residual_zero ? eye.residual.ptr<std::int32_t>(y) : nullptr;
         for (int x = 0; x < g.full.width; ++x) {
-          core_->reduced_pixel(out, eye, g, y, x, in0, in1, prev0, prev1, residual_row);
+          core_->reduced_pixel(out, eye, g, y, x, in0, in1, prev0, prev1, residual_row, gated ? &gate : nullptr);
         }
       },
       first);

@@ -17,6 +17,7 @@ FixedDecoderConfig fixed_config_of(const PipelineOptions& options) {
   config.decoder.panel = parse_panel(options.panel);
   config.decoder.output_bits = options.output_bits;
   config.decoder.lcd_history = options.lcd_history;
+  config.skip_unneeded = !options.no_skip;
   if (options.residual_bits != 0) config.residual = residual_format_of_bits(options.residual_bits, config.linear_frac_bits);
   return config;
 }

@@ -117,6 +117,9 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--seed", seed, "Seed for scenes with randomness")->capture_default_str();
   cmd.add_option("--residual-bits", residual_bits,
                  "Fixed-point residual store width N, signed sQ2.(N-2) (default: 26, lossless)");
+  cmd.add_flag("--no-skip", no_skip,
+               "Fixed-point decoders: do not skip the work a scene does not need (static lines' motion test, "
+               "all-zero residual lines); the output is bit-identical either way");
   cmd.add_option("--impl", impl,
                  "Decoder: reference (double), fixed (fixed-point, line-buffered streaming: the hardware model) or "
                  "fixed-frame (the same arithmetic frame at a time); each conceals lines and views lost on the link")

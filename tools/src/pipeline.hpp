@@ -33,6 +33,7 @@ struct PipelineOptions {
   std::string impl = "reference";     // reference | fixed (streaming, the hardware model) | fixed-frame
   bool compare_reference = false;     // with a fixed impl: also run the reference and compare codes
   int residual_bits = 0;              // fixed impl: residual store width N (sQ2.(N-2)); 0 = the default
+  bool no_skip = false;               // fixed impl: run the full path everywhere (FixedDecoderConfig::skip_unneeded)
   LcdHistory lcd_history = LcdHistory::Wanted;
 
   // Simulated display link (off when link_preset is empty and no fault or capture is asked for).

@@ -39,11 +39,16 @@ cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output
   return out;
 }
 
-// Saturation / clip events of the fixed-point decoder, per stage.
+// Saturation / clip events of the fixed-point decoder, per stage, and its DESIGN §7 skip events (output lines).
 Json events_json(const FixedStageCounts& c) {
-  return {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
-          {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
-          {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+  Json j = {{"beta_clipped", c.beta_clipped},         {"residual_saturated", c.residual_saturated},
+            {"residual_rounded", c.residual_rounded}, {"alpha_clipped", c.alpha_clipped},
+            {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
+  j["skipped"] = {{"motion_test_lines", c.motion_test_lines_skipped},
+                  {"residual_read_lines", c.residual_read_lines_skipped},
+                  {"residual_write_lines", c.residual_write_lines_skipped},
+                  {"grey_pixels", c.grey_pixels_skipped}};
+  return j;
 }
 
 Json json_number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
@@ -131,6 +136,12 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     fixed_totals_.alpha_clipped += c.alpha_clipped;
     fixed_totals_.weight_underflow += c.weight_underflow;
     fixed_totals_.lcd_unreachable += c.lcd_unreachable;
+    fixed_totals_.motion_test_lines_skipped += c.motion_test_lines_skipped;
+    fixed_totals_.residual_read_lines_skipped += c.residual_read_lines_skipped;
+    fixed_totals_.residual_write_lines_skipped += c.residual_write_lines_skipped;
+    fixed_totals_.grey_pixels_skipped += c.grey_pixels_skipped;
+    if (meta.parity == Parity::Reduced && d.stats.residual_applied) skip_lines_reduced_ += meta.full_height;
+    if (meta.parity == Parity::Full) skip_lines_full_ += meta.full_height;
     have_fixed_counts_ = true;
   }
   if (view.reference) {
@@ -204,6 +215,7 @@ Json RunRecorder::report(double wall_seconds) const {
   p["panel"] = options_.panel;
   p["impl"] = options_.impl;
   p["seed"] = options_.seed;
+  if (options_.impl != "reference") p["skip_unneeded"] = !options_.no_skip;
   r["parameters"] = p;
 
   Json s;
@@ -280,6 +292,13 @@ std::string RunRecorder::summary_table() const {
         fmt("%.4f %% identical", 100.0 * vs_free_running_.identical_fraction()) +
             fmt(", max %.0f LSB", vs_free_running_.max_lsb) +
             fmt(", merge M within %.3f codes", vs_free_running_.max_merge_codes));
+  }
+  if (have_fixed_counts_ && (skip_lines_reduced_ > 0 || skip_lines_full_ > 0)) {
+    const auto share = [&](std::uint64_t n, std::int64_t of) { return of > 0 ? 100.0 * static_cast<double>(n) / static_cast<double>(of) : 0.0; };
+    row("lines skipped (fixed-point)",
+        fmt("motion test %.1f %%", share(fixed_totals_.motion_test_lines_skipped, skip_lines_reduced_)) +
+            fmt(", residual read %.1f %%", share(fixed_totals_.residual_read_lines_skipped, skip_lines_reduced_)) +
+            fmt(", residual write %.1f %%", share(fixed_totals_.residual_write_lines_skipped, skip_lines_full_)));
   }
   if (have_fixed_counts_ && fixed_totals_.residual_saturated > 0) {
     row("residual store saturations", std::to_string(fixed_totals_.residual_saturated) + " samples");

@@ -65,6 +65,8 @@ class RunRecorder {
   CodeAgreement vs_reference_;
   CodeAgreement vs_free_running_;  // LCD only
   FixedStageCounts fixed_totals_;
+  std::int64_t skip_lines_reduced_ = 0;  // output lines of reduced views with a residual (motion / residual-read skips)
+  std::int64_t skip_lines_full_ = 0;     // output lines of full views (residual-write skips)
   bool have_fixed_counts_ = false;
   double sum_render_ = 0;
 };

@@ -106,6 +106,21 @@ struct FixedDecoderConfig {
   // joins rho.
   int lcd_segments_per_octave = 512;
 
+  // DESIGN §7, "leave out what a scene does not need", gated as hardware would; the output is bit-identical either
+  // way (false runs the full path everywhere):
+  //   * static lines skip the motion test: a line comparator checks each reduced input line against the stored
+  //     d_{t-1} row as it streams in (exact ties resolved as the motion test resolves them); an output line whose U
+  //     source rows (both, or the upper one alone where the lower has bilinear weight 0) all matched has
+  //     L_{t-1} = alpha exactly, hence c = 0 and w = 1: U of d_{t-1}, luma, reciprocal and exp are not evaluated and
+  //     the d_{t-1} rows are not read (except for the exact-tie correction, where a tie made a stored code differ);
+  //   * lines without clipping skip residual traffic: a full frame flags each output line whose stored rho is all
+  //     zero (one bit per line); such a line is not written to the residual store, and the next reduced frame
+  //     neither reads nor adds it (alpha' = clamp(alpha)). The motion test still runs there: its w feeds the
+  //     frame's mean motion weight and underflow count;
+  //   * OLED has no LCD stores (v_{t-1}, x_{t-1}) in any case.
+  // Grey content (R = G = B) computing one channel: not implemented (see FixedStageCounts).
+  bool skip_unneeded = true;
+
   // Throws std::invalid_argument naming the stage whose format or table is unusable.
   void validate() const;
 };
@@ -118,6 +133,14 @@ struct FixedStageCounts {
   std::uint64_t alpha_clipped = 0;       // Eq. 4: alpha + w rho outside [0, 1] (reduced frames)
   std::uint64_t weight_underflow = 0;    // Eq. 6: pixels with s c >= 16, w forced to 0
   std::uint64_t lcd_unreachable = 0;     // LCD: M(v, v_{t-1}) = m had no root in [0, 1]
+  // Skip events (FixedDecoderConfig::skip_unneeded; all 0 when it is false), in output lines of the frame:
+  std::uint64_t motion_test_lines_skipped = 0;    // reduced: lines whose motion test was skipped (static, w = 1)
+  std::uint64_t residual_read_lines_skipped = 0;  // reduced: lines with no residual to read or add
+  std::uint64_t residual_write_lines_skipped = 0; // full: lines whose rho is all zero (not written to the store)
+  // Grey pixels (R = G = B along the path) computed on one channel: not implemented, always 0. It could only apply
+  // with equal per-channel panel gammas (LCD, or an OLED with one gamma; not the Vive / Rift presets, whose drive
+  // ROMs differ per channel) and, on LCD, equal v_{t-1} and x_{t-1} across the pixel's channels.
+  std::uint64_t grey_pixels_skipped = 0;
 };
 
 // One line buffer or frame store of the streaming model.

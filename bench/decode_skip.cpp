@@ -1,0 +1,86 @@
+// Decode time of the fixed-point streaming decoder with the DESIGN §7 skips on and off
+// (FixedDecoderConfig::skip_unneeded), on the static scene (every line of a reduced frame skips the motion test)
+// and a moving one (discs). Items are decoded views. BM_DecodeSkipRatio times both paths in each iteration and
+// reports time(skip) / time(full path) as the counter "skip_over_full".
+#include "trm/encoder.hpp"
+#include "trm/fixed_decoder.hpp"
+#include "trm/scene.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace trm;
+
+constexpr int kWidth = 160;
+constexpr int kHeight = 120;
+constexpr int kFrames = 6;
+
+const char* scene_of(std::int64_t arg) { return arg == 0 ? "static" : "discs"; }
+
+EncoderConfig link_config() {
+  EncoderConfig link;
+  link.reduction = 0.5;
+  return link;
+}
+
+std::vector<LinkFrame> frames_of(const std::string& scene_name) {
+  SceneParams params;
+  params.width = kWidth;
+  params.height = kHeight;
+  params.supersample = 2;
+  auto scene = make_scene(scene_name, params);
+  const TrmEncoder encoder(link_config());
+  std::vector<LinkFrame> frames;
+  for (int t = 0; t < kFrames; ++t) frames.push_back(encoder.encode(scene->linear_frame(t), t, 0));
+  return frames;
+}
+
+FixedDecoderConfig config_of(bool skip) {
+  FixedDecoderConfig config;
+  config.decoder.link = link_config();
+  config.decoder.panel = parse_panel("vive");
+  config.skip_unneeded = skip;
+  return config;
+}
+
+void decode_all(FixedStreamingDecoder& decoder, const std::vector<LinkFrame>& frames) {
+  for (const LinkFrame& f : frames) benchmark::DoNotOptimize(decoder.decode(f));
+}
+
+// Args: scene (0 = static, 1 = discs), skip (0 = full path, 1 = skip_unneeded).
+void BM_DecodeSkip(benchmark::State& state) {
+  const std::vector<LinkFrame> frames = frames_of(scene_of(state.range(0)));
+  FixedStreamingDecoder decoder(config_of(state.range(1) != 0));
+  for (auto _ : state) decode_all(decoder, frames);
+  state.SetItemsProcessed(state.iterations() * kFrames);
+  state.SetLabel(std::string(scene_of(state.range(0))) + (state.range(1) != 0 ? " skip" : " full path"));
+}
+BENCHMARK(BM_DecodeSkip)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond);
+
+// Arg: scene. Both decoders on the same frames in every iteration; the counter is the mean time ratio.
+void BM_DecodeSkipRatio(benchmark::State& state) {
+  const std::vector<LinkFrame> frames = frames_of(scene_of(state.range(0)));
+  FixedStreamingDecoder full(config_of(false));
+  FixedStreamingDecoder skip(config_of(true));
+  double full_seconds = 0.0;
+  double skip_seconds = 0.0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    decode_all(full, frames);
+    const auto t1 = std::chrono::steady_clock::now();
+    decode_all(skip, frames);
+    const auto t2 = std::chrono::steady_clock::now();
+    full_seconds += std::chrono::duration<double>(t1 - t0).count();
+    skip_seconds += std::chrono::duration<double>(t2 - t1).count();
+  }
+  state.counters["skip_over_full"] = full_seconds > 0.0 ? skip_seconds / full_seconds : 0.0;
+  state.SetLabel(scene_of(state.range(0)));
+}
+BENCHMARK(BM_DecodeSkipRatio)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,294 @@
+// DESIGN §7 "leave out what a scene does not need": the fixed-point decoders with FixedDecoderConfig::skip_unneeded
+// (static lines skip the motion test, all-zero residual lines skip the residual store traffic) give the same bits
+// as the full path, in both schedules, and count what they skipped.
+#include "fixed_decoder_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace trm {
+namespace {
+
+using test::encode_sequence;
+using test::expect_identical_outputs;
+using test::fixed_config;
+using test::link_config;
+using test::scene_images;
+
+FixedDecoderConfig with_skip(FixedDecoderConfig config, bool skip) {
+  config.skip_unneeded = skip;
+  return config;
+}
+
+void expect_skip_counts_equal(const FixedStageCounts& a, const FixedStageCounts& b, const std::string& where) {
+  EXPECT_EQ(a.motion_test_lines_skipped, b.motion_test_lines_skipped) << where;
+  EXPECT_EQ(a.residual_read_lines_skipped, b.residual_read_lines_skipped) << where;
+  EXPECT_EQ(a.residual_write_lines_skipped, b.residual_write_lines_skipped) << where;
+  EXPECT_EQ(a.grey_pixels_skipped, b.grey_pixels_skipped) << where;
+}
+
+// Per view: the skip counters of the skipping streaming decoder (the frame schedule's are asserted equal).
+struct SkipRun {
+  std::vector<LinkFrame> frames;
+  std::vector<FixedStageCounts> counts;
+  std::vector<DecodedFrame> decoded;
+};
+
+// Decodes the frames with skips on and off in both schedules: all four outputs, statistics and stage counters
+// identical; the two skipping schedules count the same skips; the full path counts none.
+SkipRun decode_both_ways(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
+                         const std::string& what) {
+  FixedFrameDecoder frame_full(with_skip(config, false));
+  FixedStreamingDecoder streaming_full(with_skip(config, false));
+  FixedFrameDecoder frame_skip(with_skip(config, true));
+  FixedStreamingDecoder streaming_skip(with_skip(config, true));
+  SkipRun run;
+  run.frames = frames;
+  for (const LinkFrame& f : frames) {
+    const std::string where = what + " t=" + std::to_string(f.meta.index) + " eye=" + std::to_string(f.meta.eye);
+    const DecodedFrame a = frame_full.decode(f);
+    const DecodedFrame b = streaming_full.decode(f);
+    const DecodedFrame c = frame_skip.decode(f);
+    const DecodedFrame d = streaming_skip.decode(f);
+    expect_identical_outputs(a, frame_full.last_counts(), b, streaming_full.last_counts(), where + " full path");
+    expect_identical_outputs(a, frame_full.last_counts(), c, frame_skip.last_counts(), where + " frame skip");
+    expect_identical_outputs(a, frame_full.last_counts(), d, streaming_skip.last_counts(), where + " streaming skip");
+    expect_skip_counts_equal(frame_skip.last_counts(), streaming_skip.last_counts(), where + " skip schedules");
+    expect_skip_counts_equal(frame_full.last_counts(), FixedStageCounts(), where + " full path counts no skip");
+    if (::testing::Test::HasFatalFailure()) return run;
+    run.counts.push_back(streaming_skip.last_counts());
+    run.decoded.push_back(d);
+  }
+  return run;
+}
+
+struct Rates {
+  std::uint64_t reduced_lines = 0;  // output lines of reduced views with a residual
+  std::uint64_t full_lines = 0;
+  std::uint64_t motion = 0;
+  std::uint64_t read = 0;
+  std::uint64_t write = 0;
+  void add(const SkipRun& run) {
+    for (std::size_t n = 0; n < run.counts.size(); ++n) {
+      const FrameMeta& m = run.frames[n].meta;
+      if (m.parity == Parity::Full) {
+        full_lines += static_cast<std::uint64_t>(m.full_height);
+      } else if (run.decoded[n].stats.residual_applied) {
+        reduced_lines += static_cast<std::uint64_t>(m.full_height);
+      }
+      motion += run.counts[n].motion_test_lines_skipped;
+      read += run.counts[n].residual_read_lines_skipped;
+      write += run.counts[n].residual_write_lines_skipped;
+    }
+  }
+  static double pct(std::uint64_t n, std::uint64_t of) { return of ? 100.0 * static_cast<double>(n) / static_cast<double>(of) : 0.0; }
+};
+
+TEST(FixedSkip, BitIdenticalToTheFullPathOnEveryScene) {
+  for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
+    for (const std::string& name : scene_names()) {
+      const std::vector<cv::Mat> images = scene_images(name, 24, 18, 4);
+      Rates rates;
+      for (double r : {1.0, 0.5, 0.4}) {
+        const EncoderConfig link = link_config(r, 0, true);
+        const std::string what = name + " " + panel + " r=" + std::to_string(r);
+        rates.add(decode_both_ways(encode_sequence(images, link), fixed_config(link, panel), what));
+        if (HasFatalFailure()) return;
+      }
+      std::printf("[ skip ] %-10s %-4s motion test %5.1f %%  residual read %5.1f %%  residual write %5.1f %% of lines\n",
+                  name.c_str(), panel.c_str(), Rates::pct(rates.motion, rates.reduced_lines),
+                  Rates::pct(rates.read, rates.reduced_lines), Rates::pct(rates.write, rates.full_lines));
+    }
+  }
+}
+
+TEST(FixedSkip, BitIdenticalInTheLinearResampleSpaceAndAt10Bits) {
+  const std::vector<cv::Mat> images = scene_images("discs", 21, 17, 4);
+  for (const EncoderConfig& link : {link_config(0.5, 1, true, 8, ResampleSpace::Linear), link_config(0.4, 0, false, 10)}) {
+    decode_both_ways(encode_sequence(images, link), fixed_config(link, "vive", 10), "discs variant");
+    if (HasFatalFailure()) return;
+  }
+}
+
+TEST(FixedSkip, StaticSceneSkipsTheMotionTestOnEveryLine) {
+  for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
+    for (double r : {1.0, 0.5, 0.4}) {
+      const EncoderConfig link = link_config(r, 0, true);
+      const SkipRun run =
+          decode_both_ways(encode_sequence(scene_images("static", 32, 24, 6), link), fixed_config(link, panel), "static");
+      ASSERT_FALSE(HasFatalFailure());
+      int checked = 0;
+      for (std::size_t n = 0; n < run.counts.size(); ++n) {
+        const FrameMeta& m = run.frames[n].meta;
+        if (m.parity != Parity::Reduced) continue;
+        if (!run.decoded[n].stats.residual_applied) continue;  // the eye's first view (no full frame before it)
+        EXPECT_EQ(run.counts[n].motion_test_lines_skipped, static_cast<std::uint64_t>(m.full_height))
+            << panel << " r=" << r << " t=" << m.index << " eye=" << m.eye;
+        EXPECT_EQ(run.decoded[n].stats.mean_motion_weight, 1.0);
+        ++checked;
+      }
+      EXPECT_EQ(checked, 5);  // stereo, 6 frames: every reduced view after each eye's first full view
+    }
+  }
+}
+
+// A smooth, dim scene never clips: no full line is written to the residual store and no reduced line reads one.
+TEST(FixedSkip, NoClippingMeansNoResidualTraffic) {
+  std::vector<cv::Mat> images;
+  for (int t = 0; t < 4; ++t) {
+    cv::Mat image(20, 28, CV_64FC3);
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        const double v = 0.25 + 0.004 * (x + 2 * t) + 0.002 * y;  // a gentle ramp, drifting
+        image.at<cv::Vec3d>(y, x) = cv::Vec3d(v, 0.9 * v, 0.8 * v);
+      }
+    }
+    images.push_back(image);
+  }
+  for (double r : {1.0, 0.5, 0.4}) {
+    const EncoderConfig link = link_config(r, 0, true);
+    const SkipRun run = decode_both_ways(encode_sequence(images, link), fixed_config(link, "vive"), "ramp");
+    ASSERT_FALSE(HasFatalFailure());
+    for (std::size_t n = 0; n < run.counts.size(); ++n) {
+      const FrameMeta& m = run.frames[n].meta;
+      const auto lines = static_cast<std::uint64_t>(m.full_height);
+      if (m.parity == Parity::Full) {
+        EXPECT_EQ(run.decoded[n].stats.clipped_fraction, 0.0) << "r=" << r << " t=" << m.index;
+        EXPECT_EQ(run.counts[n].residual_write_lines_skipped, lines) << "r=" << r << " t=" << m.index;
+      } else if (run.decoded[n].stats.residual_applied) {
+        EXPECT_EQ(run.counts[n].residual_read_lines_skipped, lines) << "r=" << r << " t=" << m.index;
+      }
+    }
+  }
+}
+
+// A constructed case with counts known in advance: 16x16 at r = 1/2 (8x8 reduced, U rows i0 = floor(y/2 - 1/4)).
+// Full frame: flat code 100 with one white pixel at (3, 6): only line 6 clips, so 15 of 16 lines write no residual
+// and the next reduced frame reads the residual on line 6 alone. Reduced frame: the decoder's own d_t except reduced
+// row 5, so output lines 9..12 (whose U rows include 5) run the motion test and the other 12 skip it.
+TEST(FixedSkip, CountsAreExactOnAConstructedCase) {
+  const EncoderConfig link = link_config(0.5);
+  const FixedDecoderConfig config = fixed_config(link, "vive");
+  LinkFrame full;
+  full.meta.index = 0;
+  full.meta.parity = Parity::Full;
+  full.meta.width = full.meta.full_width = 16;
+  full.meta.height = full.meta.full_height = 16;
+  full.meta.bits = 8;
+  full.codes = cv::Mat(16, 16, CV_16UC3, cv::Scalar(100, 100, 100));
+  full.codes.at<cv::Vec<std::uint16_t, 3>>(6, 3) = cv::Vec<std::uint16_t, 3>(255, 255, 255);
+
+  FixedFrameDecoder tapping(with_skip(config, false));
+  FixedStageTaps taps;
+  tapping.decode(full, taps);
+  const FixedStagePlane& d = taps[FixedStage::Reduced];
+  ASSERT_EQ(d.size, cv::Size(8, 8));
+  LinkFrame reduced;
+  reduced.meta = full.meta;
+  reduced.meta.index = 1;
+  reduced.meta.parity = Parity::Reduced;
+  reduced.meta.width = reduced.meta.height = 8;
+  reduced.codes = cv::Mat(8, 8, CV_16UC3);
+  for (int k = 0; k < 8; ++k) {
+    for (int i = 0; i < 24; ++i) {
+      const std::int64_t stored = d.values[static_cast<std::size_t>(k * 24 + i)];
+      ASSERT_LT(stored, 256) << "no exact tie expected";
+      reduced.codes.ptr<std::uint16_t>(k)[i] = static_cast<std::uint16_t>(k == 5 ? stored + 7 : stored);
+    }
+  }
+  int residual_lines = 0;
+  const FixedStagePlane& rho = taps[FixedStage::Residual];
+  for (int y = 0; y < 16; ++y) {
+    bool nonzero = false;
+    for (int i = 0; i < 48; ++i) nonzero = nonzero || rho.values[static_cast<std::size_t>(y * 48 + i)] != 0;
+    residual_lines += nonzero ? 1 : 0;
+  }
+  ASSERT_EQ(residual_lines, 1);  // the construction: only the white pixel's line clips
+
+  const SkipRun run = decode_both_ways({full, reduced}, config, "constructed");
+  ASSERT_FALSE(HasFatalFailure());
+  EXPECT_EQ(run.counts[0].residual_write_lines_skipped, 15u);
+  EXPECT_EQ(run.counts[0].motion_test_lines_skipped, 0u);
+  EXPECT_EQ(run.counts[0].residual_read_lines_skipped, 0u);
+  EXPECT_EQ(run.counts[1].motion_test_lines_skipped, 12u);
+  EXPECT_EQ(run.counts[1].residual_read_lines_skipped, 15u);
+  EXPECT_EQ(run.counts[1].residual_write_lines_skipped, 0u);
+  EXPECT_EQ(run.counts[1].grey_pixels_skipped, 0u);
+  EXPECT_LT(run.decoded[1].stats.mean_motion_weight, 1.0);  // the motion test did run on lines 9..12
+}
+
+// Stored d_t codes with an exact tie (flagged) and a received code one below: the line still counts as static (the
+// motion test resolves the tie the same way) and the tie correction is still applied, bit-identically.
+TEST(FixedSkip, ExactTiesKeepStaticLinesStatic) {
+  // Columns alternating 100 / 101 at r = 1/2: mirror-symmetric taps pair an even with an odd column, so D is exactly
+  // 100.5 away from the borders (see fixed_kernels.hpp, kTieFlag).
+  const EncoderConfig link = link_config(0.5);
+  const FixedDecoderConfig config = fixed_config(link, "vive");
+  LinkFrame full;
+  full.meta.index = 0;
+  full.meta.parity = Parity::Full;
+  full.meta.width = full.meta.full_width = 48;
+  full.meta.height = full.meta.full_height = 12;
+  full.codes = cv::Mat(12, 48, CV_16UC3);
+  for (int y = 0; y < 12; ++y) {
+    for (int x = 0; x < 48; ++x) {
+      const std::uint16_t v = x % 2 == 0 ? 100 : 101;
+      full.codes.at<cv::Vec<std::uint16_t, 3>>(y, x) = cv::Vec<std::uint16_t, 3>(v, v, v);
+    }
+  }
+  FixedFrameDecoder tapping(with_skip(config, false));
+  FixedStageTaps taps;
+  tapping.decode(full, taps);
+  const FixedStagePlane& d = taps[FixedStage::Reduced];
+  LinkFrame reduced;
+  reduced.meta = full.meta;
+  reduced.meta.index = 1;
+  reduced.meta.parity = Parity::Reduced;
+  reduced.meta.width = d.size.width;
+  reduced.meta.height = d.size.height;
+  reduced.codes = cv::Mat(d.size, CV_16UC3);
+  int ties = 0;
+  for (int k = 0; k < d.size.height; ++k) {
+    for (int i = 0; i < 3 * d.size.width; ++i) {
+      const std::int64_t stored = d.values[static_cast<std::size_t>(k * 3 * d.size.width + i)];
+      const bool tie = stored >= 256;
+      ties += tie ? 1 : 0;
+      // The encoder may round a tie either way: take the lower code on every other row.
+      reduced.codes.ptr<std::uint16_t>(k)[i] = static_cast<std::uint16_t>((stored & 255) - (tie && k % 2 == 0 ? 1 : 0));
+    }
+  }
+  ASSERT_GT(ties, 0) << "the construction needs exact ties";
+  const SkipRun run = decode_both_ways({full, reduced}, config, "ties");
+  ASSERT_FALSE(HasFatalFailure());
+  EXPECT_EQ(run.counts[1].motion_test_lines_skipped, 12u);
+}
+
+TEST(FixedSkip, ReportListsTheSkipStorageAndNoLcdStoresForOled) {
+  const EncoderConfig link = link_config(0.5);
+  const auto names = [](const FixedStreamingReport& r) {
+    std::string all;
+    for (const FixedBufferReport& b : r.buffers) all.append(b.name).append("\n");
+    return all;
+  };
+  const FixedStreamingReport oled = FixedStreamingDecoder(fixed_config(link, "vive")).report(cv::Size(64, 48));
+  const std::string oled_names = names(oled);
+  EXPECT_EQ(oled_names.find("LCD"), std::string::npos) << oled_names;
+  bool flags_found = false;
+  for (const FixedBufferReport& b : oled.buffers) {
+    if (b.name.find("residual-nonzero") == std::string::npos) continue;
+    flags_found = true;
+    EXPECT_EQ(b.total_bits(), 48);  // one bit per full line
+  }
+  EXPECT_TRUE(flags_found) << oled_names;
+  const FixedStreamingReport full_path =
+      FixedStreamingDecoder(with_skip(fixed_config(link, "vive"), false)).report(cv::Size(64, 48));
+  EXPECT_EQ(names(full_path).find("residual-nonzero"), std::string::npos);
+  const FixedStreamingReport lcd = FixedStreamingDecoder(fixed_config(link, "lcd")).report(cv::Size(64, 48));
+  EXPECT_NE(names(lcd).find("LCD"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace trm
