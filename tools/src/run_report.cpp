@@ -293,7 +293,9 @@ std::string RunRecorder::summary_table() const {
             fmt(", max %.0f LSB", vs_free_running_.max_lsb) +
             fmt(", merge M within %.3f codes", vs_free_running_.max_merge_codes));
   }
-  if (have_fixed_counts_ && (skip_lines_reduced_ > 0 || skip_lines_full_ > 0)) {
+  if (have_fixed_counts_ && options_.no_skip) {
+    row("lines skipped (fixed-point)", "none: full path everywhere (--no-skip)");
+  } else if (have_fixed_counts_ && (skip_lines_reduced_ > 0 || skip_lines_full_ > 0)) {
     const auto share = [&](std::uint64_t n, std::int64_t of) { return of > 0 ? 100.0 * static_cast<double>(n) / static_cast<double>(of) : 0.0; };
     row("lines skipped (fixed-point)",
         fmt("motion test %.1f %%", share(fixed_totals_.motion_test_lines_skipped, skip_lines_reduced_)) +
