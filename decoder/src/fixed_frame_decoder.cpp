@@ -14,8 +14,8 @@ using fixed_detail::Raw;
 
 namespace {
 
-// d_t = Q_b(D(E_t)) over the whole frame: the horizontal pass on every row, then the vertical pass. The codes carry
-// the exact-tie flag (kTieFlag) as the d_t frame store holds them.
+// d_t = Q_b(D(E_t)) over the whole frame: the horizontal pass on every row, then the vertical pass; link codes as
+// the d_t frame store holds them.
 cv::Mat reduce_whole_frame(const fixed_detail::FixedKernels& kernels, const Geometry& g, const cv::Mat& codes) {
   const int samples = 3 * g.reduced.width;
   std::vector<std::vector<Raw>> horizontal(static_cast<std::size_t>(g.full.height), std::vector<Raw>(static_cast<std::size_t>(samples)));
@@ -107,29 +107,18 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
   core_->begin_lcd(out, eye);
   if (taps != nullptr) {
     core_->start_taps(out, *taps, g, out.full,
-                      !out.full && eye.have_residual && eye.residual_index + 1 == frame.meta.index);
+                      !out.full && eye.have_residual && eye.residual_index == frame.meta.index - 1);
   }
   const auto row_of = [](const cv::Mat& m, int y) { return m.ptr<std::uint16_t>(y); };
 
   if (frame.meta.parity == Parity::Full) {
-    const cv::Mat low_store = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t with tie flags
+    const cv::Mat low = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t codes
     if (taps != nullptr) {
-      const int b = core_->config().decoder.link.bits;
       std::vector<std::int64_t>& d = (*taps)[FixedStage::Reduced].values;
-      for (int k = 0; k < low_store.rows; ++k) {
-        const std::uint16_t* in = low_store.ptr<std::uint16_t>(k);
-        for (int i = 0; i < 3 * low_store.cols; ++i) {
-          const bool tie = (in[i] & fixed_detail::kTieFlag) != 0;
-          d[static_cast<std::size_t>(k) * 3 * static_cast<std::size_t>(low_store.cols) + static_cast<std::size_t>(i)] =
-              fixed_detail::code_of(in[i]) | (tie ? std::int64_t{1} << b : 0);
-        }
+      for (int k = 0; k < low.rows; ++k) {
+        const std::uint16_t* in = low.ptr<std::uint16_t>(k);
+        std::copy(in, in + 3 * low.cols, d.begin() + static_cast<std::ptrdiff_t>(k) * 3 * low.cols);
       }
-    }
-    cv::Mat low(low_store.size(), CV_16UC3);                                          // d_t codes
-    for (int k = 0; k < low.rows; ++k) {
-      const std::uint16_t* in = low_store.ptr<std::uint16_t>(k);
-      std::uint16_t* out_row = low.ptr<std::uint16_t>(k);
-      for (int i = 0; i < 3 * low.cols; ++i) out_row[i] = fixed_detail::code_of(in[i]);
     }
     cv::Mat residual(g.full, CV_32SC3);
     for (int y = 0; y < g.full.height; ++y) {
@@ -143,11 +132,12 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
     eye.have_residual = true;
     eye.residual_index = frame.meta.index;
     eye.residual = residual;
-    eye.previous_low = low_store;
+    eye.previous_low = low;
     return core_->finish(std::move(out), eye, true, false);
   }
 
-  const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
+  // frame.meta.index >= 0 (checked by begin), so index - 1 cannot overflow.
+  const bool residual_applies = eye.have_residual && eye.residual_index == frame.meta.index - 1;
   const bool gated = residual_applies && core_->skipping();
   const std::vector<std::uint8_t> line_flags = gated ? compare_lines(frame.codes, eye.previous_low, lost)
                                                      : std::vector<std::uint8_t>();
@@ -156,7 +146,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
     if (gated) {
       const fixed_detail::ReducedLineGate gate = core_->reduced_line_gate(
           out, eye, g, y, [&](int k) { return line_flags[static_cast<std::size_t>(k)]; });
-      const bool read_previous = !gate.motion_static || gate.tie_rows;
+      const bool read_previous = !gate.motion_static;
       for (int x = 0; x < g.full.width; ++x) {
         core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
                              read_previous ? row_of(eye.previous_low, row.i0) : nullptr,

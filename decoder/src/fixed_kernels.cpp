@@ -29,10 +29,21 @@ void require_range(const std::string& stage, const char* what, int value, int lo
 // Largest-remainder rounding of non-negative weights (summing to ~1) to integers summing exactly to 2^frac_bits.
 // A mirror-symmetric weight list (taps centred on an integer or half-integer position) stays exactly symmetric:
 // mirror pairs receive their extra units together, an odd unit goes to the centre tap. Exact symmetry keeps the
-// exact half-code ties of symmetric content (a Nyquist checkerboard at r = 1/2) exact, so they can be flagged (see
-// FixedKernels::gaussian_vertical). Otherwise ties go to the lower index, so the result is deterministic.
-std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, int frac_bits) {
+// exact half-code ties of symmetric content (a Nyquist checkerboard at r = 1/2) exact, so that they round up as the
+// encoder's quantise_reduced rounds them (see FixedKernels::gaussian_vertical). Otherwise ties go to the lower index,
+// so the result is deterministic.
+// Weights that are not finite and non-negative with a positive sum (a degenerate Gaussian) are rejected, naming the
+// stage: converting NaN to an integer is undefined.
+std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, int frac_bits, const char* stage) {
   const std::size_t n = weights.size();
+  double weight_sum = 0.0;
+  for (double w : weights) {
+    if (!std::isfinite(w) || w < 0.0 || w > 1.0) {
+      reject(stage, "weight " + std::to_string(w) + " is not a finite number in [0, 1]");
+    }
+    weight_sum += w;
+  }
+  if (n == 0 || !(weight_sum > 0.5 && weight_sum < 1.5)) reject(stage, "the weights do not sum to 1");
   const double scale = std::ldexp(1.0, frac_bits);
   std::vector<std::int64_t> out(n);
   std::vector<double> remainder(n);
@@ -77,13 +88,13 @@ std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, in
 }
 
 // The linear resample space's re-encoding thresholds on the uQ1.frac_bits grid: T_k is the smallest grid value g
-// whose link code under the encoder's quantiser, floor(enc(g 2^-f) (2^b - 1) + 1/2), is k or more (T_0 = 0). The code
-// of any grid value x is then the largest k with x >= T_k, exactly as the encoder quantises that value.
+// whose link code under the encoder's reduced-frame quantiser, quantise_reduced(enc(g 2^-f)) (round half up, within
+// its tie tolerance), is k or more (T_0 = 0). The code of any grid value x is then the largest k with x >= T_k,
+// exactly as the encoder quantises that value.
 std::vector<std::int64_t> link_code_thresholds(int bits, Transfer transfer, int frac_bits) {
   const int top = (1 << bits) - 1;
   const auto code_of_grid = [&](std::int64_t g) {
-    const double encoded = std::clamp(to_encoded(std::ldexp(static_cast<double>(g), -frac_bits), transfer), 0.0, 1.0);
-    return static_cast<int>(std::floor(encoded * top + 0.5));
+    return static_cast<int>(quantise_reduced(to_encoded(std::ldexp(static_cast<double>(g), -frac_bits), transfer), bits));
   };
   std::vector<std::int64_t> t(static_cast<std::size_t>(top) + 1, 0);
   for (int k = 1; k <= top; ++k) {
@@ -241,7 +252,7 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
 
   // Eq. 5: Rec. 709 weights summing exactly to 2^W; 1/x through the normalised reciprocal LUT (uQ2.24 holds 1.0).
   const std::vector<std::int64_t> luma =
-      integer_weights({0.2126, 0.7152, 0.0722}, config_.luma_weight_frac_bits);
+      integer_weights({0.2126, 0.7152, 0.0722}, config_.luma_weight_frac_bits, "motion contrast (luma)");
   std::copy(luma.begin(), luma.end(), luma_weights_.begin());
   fx::LutShape reciprocal_shape;
   reciprocal_shape.entries = config_.reciprocal_entries;
@@ -340,7 +351,7 @@ const Geometry& FixedKernels::geometry(cv::Size full) {
     for (int k = 0; k < reduced_n; ++k) {
       const GaussianTaps taps = gaussian_taps(k, full_n, reduced_n, sigma);
       PolyphaseTaps& out = axis[static_cast<std::size_t>(k)];
-      out.weight = integer_weights(taps.weights, tap_bits);
+      out.weight = integer_weights(taps.weights, tap_bits, "D (Gaussian taps)");
       for (std::size_t i = 0; i < taps.weights.size(); ++i) {
         out.index.push_back(std::clamp(taps.first_index + static_cast<int>(i), 0, full_n - 1));
       }
@@ -375,7 +386,7 @@ Raw FixedKernels::gaussian_horizontal(const std::uint16_t* codes_row, const Poly
   Raw acc = 0;  // codes x uQ0.T
   for (std::size_t i = 0; i < taps.weight.size(); ++i) acc += taps.weight[i] * codes_row[3 * taps.index[i] + ch];
   // uQb.L, half to even: rows a, b with a + b an integer (255 - pattern) keep a + b exact, so an exact half-code
-  // tie of the vertical sum stays exact and is flagged.
+  // tie of the vertical sum stays exact and rounds up as the encoder rounds it.
   const int shift = config_.gaussian_tap_frac_bits - config_.gaussian_line_frac_bits;
   return shift > 0 ? round_convergent_shift(acc, shift) : round_shift(acc, shift);
 }
@@ -384,12 +395,9 @@ std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const Poly
   Raw acc = 0;  // uQb.(L + T); linear space uQ1.(P + T)
   for (std::size_t j = 0; j < taps.weight.size(); ++j) acc += taps.weight[j] * rows[j][sample];
   if (linear_space_) return encode_linear(round_shift(acc, config_.linear_gaussian_tap_frac_bits));
-  // Q_b: the nearest code, as the encoder's floor(x + 1/2); taps sum to 1, so no clamp is needed.
-  const int shift = config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits;
-  const auto code = static_cast<std::uint16_t>(round_shift(acc, shift));
-  // Exactly half-way: the encoder's double D lands within an ulp of the half and rounds either way.
-  const bool tie = (acc & ((Raw{1} << shift) - 1)) == (Raw{1} << (shift - 1));
-  return static_cast<std::uint16_t>(code | (tie ? kTieFlag : 0));
+  // Q_b: the nearest code, exact half-code ties up, as the encoder's quantise_reduced (which counts a double D within
+  // its rounding noise of a half as the half); taps sum to 1, so no clamp is needed.
+  return static_cast<std::uint16_t>(round_shift(acc, config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits));
 }
 
 std::uint16_t FixedKernels::encode_linear(Raw x) const {
@@ -424,29 +432,6 @@ Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1,
                            Raw row_upper, int ch) const {
   return blend(row0[3 * col.i0 + ch], row0[3 * col.i1 + ch], row1[3 * col.i0 + ch], row1[3 * col.i1 + ch], col.upper,
                row_upper);
-}
-
-bool FixedKernels::has_tie(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col,
-                           int ch) const {
-  const int a = 3 * col.i0 + ch;
-  const int b = 3 * col.i1 + ch;
-  return ((stored0[a] | stored0[b] | stored1[a] | stored1[b]) & kTieFlag) != 0;
-}
-
-Raw FixedKernels::upsample_stored(const std::uint16_t* stored0, const std::uint16_t* stored1,
-                                  const BilinearWeights& col, Raw row_upper, int ch) const {
-  const int a = 3 * col.i0 + ch;
-  const int b = 3 * col.i1 + ch;
-  return blend(code_of(stored0[a]), code_of(stored0[b]), code_of(stored1[a]), code_of(stored1[b]), col.upper, row_upper);
-}
-
-Raw FixedKernels::upsample_previous(const std::uint16_t* stored0, const std::uint16_t* stored1,
-                                    const std::uint16_t* received0, const std::uint16_t* received1,
-                                    const BilinearWeights& col, Raw row_upper, int ch) const {
-  const int a = 3 * col.i0 + ch;
-  const int b = 3 * col.i1 + ch;
-  return blend(resolve_tie(stored0[a], received0[a]), resolve_tie(stored0[b], received0[b]),
-               resolve_tie(stored1[a], received1[a]), resolve_tie(stored1[b], received1[b]), col.upper, row_upper);
 }
 
 Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
@@ -594,12 +579,10 @@ Raw FixedKernels::motion_contrast(Raw luma_previous, Raw luma_alpha) const {
   return difference == 0 ? 0 : contrast_of(difference, luma_previous + luma_alpha);
 }
 
-WeightedSample FixedKernels::add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const {
+WeightedSample FixedKernels::add_weighted_residual(Raw alpha, Raw weight, Raw residual) const {
   WeightedSample out;
-  // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho is uQ1.F x sQ.R, rounded to F fraction bits (w x the tie
-  // correction, sQ2.F, likewise; it is 0 unless d_t had an exact tie here).
-  Raw sum = alpha + round_shift(weight * residual, config_.residual.frac_bits);
-  if (tie_correction != 0) sum += round_shift(weight * tie_correction, config_.linear_frac_bits);
+  // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho is uQ1.F x sQ.R, rounded to F fraction bits.
+  const Raw sum = alpha + round_shift(weight * residual, config_.residual.frac_bits);
   out.alpha_prime = std::clamp(sum, Raw{0}, one());
   out.clipped = out.alpha_prime != sum;
   out.dropped = sum > out.alpha_prime ? sum - out.alpha_prime : out.alpha_prime - sum;
@@ -615,12 +598,7 @@ WeightedSample FixedKernels::clamp_alpha(Raw alpha) const {
 }
 
 std::uint8_t FixedKernels::compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples) {
-  std::uint8_t flags = kLineStatic;
-  for (int i = 0; i < samples; ++i) {
-    if (resolve_tie(stored[i], received[i]) != received[i]) return 0;
-    if (code_of(stored[i]) != received[i]) flags |= kLineTie;
-  }
-  return flags;
+  return std::equal(stored, stored + samples, received) ? kLineStatic : std::uint8_t{0};
 }
 
 std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
@@ -679,19 +657,17 @@ std::vector<FixedRomReport> FixedKernels::roms() const {
 
 // Operators per evaluation of each stage, counted from the functions above (worst case per evaluation; a
 // rounding "+ half LSB" before a shift counts as an adder, a clamp as two comparators, a shift or a bit-field
-// extraction as nothing). Rare paths are left out: the exact-tie correction of Eq. 4 (one more multiplier and two
-// adders where d_t held an exact half-code tie) and the LCD held first frame (a second search).
+// extraction as nothing). A rare path is left out: the LCD held first frame (a second search).
 //
 // | stage                          | per            | adders            | multipliers | comparators | ROM reads |
 // |--------------------------------|----------------|-------------------|-------------|-------------|-----------|
 // | I = lin(E)                     | sample         | 0                 | 0           | 0           | 1         |
-// | D horizontal (n_h taps)        | reduced sample | n_h               | n_h         | 1 (tie)     | 0         |
-// | D vertical + Q_b (n_v taps)    | reduced sample | n_v               | n_v         | 1 (tie)     | 0         |
+// | D horizontal (n_h taps)        | reduced sample | n_h               | n_h         | 1 (RndConv) | 0         |
+// | D vertical + Q_b (n_v taps)    | reduced sample | n_v               | n_v         | 0           | 0         |
 // | U bilinear (blend)             | sample         | 6                 | 6           | 0           | 0         |
 // | EOTF LUT (interpolated)        | sample         | 3                 | 1           | 0           | 2         |
 // | Eq. 2 beta, clamp, rho         | sample         | 2                 | 0           | 2           | 0         |
 // | residual store (round, sat.)   | sample         | 1                 | 0           | 2           | 0         |
-// | d_{t-1} exact-tie resolution   | sample         | 4                 | 0           | 5           | 0         |
 // | luma of L_{t-1} and alpha      | pixel          | 6                 | 6           | 0           | 0         |
 // | Eq. 5 contrast c               | pixel          | 6                 | 2           | 3           | 2         |
 // | Eq. 6 weight w                 | pixel          | 5                 | 3           | 1           | 3         |
@@ -700,7 +676,7 @@ std::vector<FixedRomReport> FixedKernels::roms() const {
 // | LCD drive code (Eq. 7 inverse) | sample         | 4 + 6 o           | 2 + 8 o     | 2 + o       | 4         |
 //
 // In the linear resample space D reads lin(E) from a ROM per tap and re-encodes through the threshold ROM, U reads
-// lin(code) from the I ROM per corner, and there is neither an EOTF LUT nor an exact-tie resolution:
+// lin(code) from the I ROM per corner, and there is no EOTF LUT:
 //
 // | D horizontal on lin(E) (n_h)   | reduced sample | n_h               | n_h         | 0           | n_h       |
 // | D vertical + re-encoding (n_v) | reduced sample | n_v               | n_v         | b           | b         |
@@ -749,14 +725,13 @@ std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) c
       {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
       {"D horizontal (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line", horizontal,
        n_h, n_h, 1, 0},
-      {"D vertical + Q_b (" + std::to_string(n_v) + " taps)", "full", "reduced sample", vertical, n_v, n_v, 1, 0},
+      {"D vertical + Q_b (" + std::to_string(n_v) + " taps)", "full", "reduced sample", vertical, n_v, n_v, 0, 0},
       {"U bilinear of d_t", "full", "channel sample", samples, 6, 6, 0, 0},
       {"EOTF LUT: L = lin(U(d_t))", "full", "channel sample", samples, 3, 1, 0, 2},
       {"Eq. 2 beta = 2I - L, shown, rho", "full", "channel sample", samples, 2, 0, 2, 0},
       {"residual store (round, saturate)", "full", "channel sample", samples, 1, 0, 2, 0},
       {"U bilinear of i", "reduced", "channel sample", samples, 6, 6, 0, 0},
       {"EOTF LUT: alpha = lin(U(i))", "reduced", "channel sample", samples, 3, 1, 0, 2},
-      {"d_{t-1} exact-tie resolution", "reduced", "channel sample", samples, 4, 0, 5, 0},
       {"U bilinear of d_{t-1}", "reduced", "channel sample", samples, 6, 6, 0, 0},
       {"EOTF LUT: L_{t-1} = lin(U(d_{t-1}))", "reduced", "channel sample", samples, 3, 1, 0, 2},
       {"luma of L_{t-1} and alpha", "reduced", "pixel", pixels, 6, 6, 0, 0},
@@ -778,27 +753,68 @@ std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) c
 
 FixedDecoderCore::FixedDecoderCore(FixedDecoderConfig config) : kernels_(config) {}
 
+namespace {
+
+// The metadata every view needs, also a lost one (as the reference checks it): index (the residual adjacency test
+// compares the stored index with index - 1, which needs index >= 0), eye, and a view size within kMaxViewSide, so
+// that a corrupted header is rejected before taps or frame stores of that size are built.
+void check_view_meta(const FrameMeta& meta, const std::string& what) {
+  if (meta.index < 0) throw std::invalid_argument(what + "frame index must be >= 0");
+  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
+  if (meta.full_width < 1 || meta.full_height < 1 || meta.full_width > kMaxViewSide ||
+      meta.full_height > kMaxViewSide) {
+    std::string message = what;
+    message.append("full size must be at least 1x1 and at most ")
+        .append(std::to_string(kMaxViewSide))
+        .append("x")
+        .append(std::to_string(kMaxViewSide))
+        .append(", got ")
+        .append(std::to_string(meta.full_width))
+        .append("x")
+        .append(std::to_string(meta.full_height));
+    throw std::invalid_argument(message);
+  }
+}
+
+std::string size_text(int width, int height) { return std::to_string(width).append("x").append(std::to_string(height)); }
+
+}  // namespace
+
 EyeState& FixedDecoderCore::begin(const LinkFrame& frame, const char* who) {
   const FixedDecoderConfig& config = kernels_.config();
   const FrameMeta& meta = frame.meta;
-  const std::string what = std::string(who) + ": " + to_string(meta.parity) + " frame t=" + std::to_string(meta.index) +
-                           " eye=" + std::to_string(meta.eye) + ": ";
-  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
+  std::string what = who;
+  what.append(": ")
+      .append(to_string(meta.parity))
+      .append(" frame t=")
+      .append(std::to_string(meta.index))
+      .append(" eye=")
+      .append(std::to_string(meta.eye))
+      .append(": ");
+  check_view_meta(meta, what);
   if (meta.bits != config.decoder.link.bits) throw std::invalid_argument(what + "link bits do not match the decoder");
   if (meta.transfer != config.decoder.link.transfer) {
     throw std::invalid_argument(what + "transfer does not match the decoder");
   }
-  if (meta.full_width < 1 || meta.full_height < 1) throw std::invalid_argument(what + "full size must be at least 1x1");
   if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
     throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
   }
+  // The codes against their own metadata first (a mismatch there is named as such), then against the view size:
+  // both before the geometry of the view is built, so a frame claiming a view it cannot be part of allocates nothing.
+  const std::string codes_size = size_text(frame.codes.cols, frame.codes.rows);
+  if (frame.codes.cols != meta.width || frame.codes.rows != meta.height) {
+    throw std::invalid_argument(what + "codes are " + codes_size + " but the metadata says " +
+                                size_text(meta.width, meta.height));
+  }
   const cv::Size full(meta.full_width, meta.full_height);
-  const Geometry& g = kernels_.geometry(full);
-  const cv::Size expected = meta.parity == Parity::Full ? full : g.reduced;
-  if (frame.codes.size() != expected || meta.width != expected.width || meta.height != expected.height) {
-    throw std::invalid_argument(what + "codes are " + std::to_string(frame.codes.cols) + "x" +
-                                std::to_string(frame.codes.rows) + " but must be " + std::to_string(expected.width) +
-                                "x" + std::to_string(expected.height));
+  const double r = config.decoder.link.reduction;
+  const cv::Size expected = meta.parity == Parity::Full
+                                ? full
+                                : cv::Size(reduced_size(full.width, r), reduced_size(full.height, r));
+  if (frame.codes.size() != expected) {
+    throw std::invalid_argument(what + "codes are " + codes_size + " but a " + to_string(meta.parity) +
+                                " frame of a " + size_text(full.width, full.height) + " view at r=" +
+                                std::to_string(r) + " must be " + size_text(expected.width, expected.height));
   }
   double highest = 0.0;
   cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
@@ -923,20 +939,13 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
     }
     return;
   }
-  // L_{t-1} for the motion test, exact ties resolved towards the received codes; and the tie correction: the full
-  // frame compensated against the unresolved L_used, so L_used - L_resolved joins rho (Eq. 3 then holds exactly for
-  // static content, as in the reference, whose d_t is the encoder's own rounding).
+  // L_{t-1} for the motion test, from the stored d_{t-1}: the low-pass the full frame compensated against, bit for
+  // bit (d_t rounds exact ties up, as the encoder's reduced frame does, so for static content it is the received i).
   Raw previous[3];
-  Raw tie_correction[3] = {0, 0, 0};
   for (int ch = 0; ch < 3; ++ch) {
-    // Static line (DESIGN §7): the resolved d_{t-1} rows equal the received ones, so U of them is alpha.
+    // Static line (DESIGN §7): the d_{t-1} rows equal the received ones, so U of them is alpha.
     previous[ch] = motion_static ? alpha[ch]
-                                 : kernels_.linear_of_upsampled(
-                                       kernels_.upsample_previous(prev0, prev1, in0, in1, col, row.upper, ch));
-    if ((!motion_static || gate->tie_rows) && kernels_.has_tie(prev0, prev1, col, ch)) {
-      tie_correction[ch] = kernels_.linear_of_upsampled(kernels_.upsample_stored(prev0, prev1, col, row.upper, ch)) -
-                           previous[ch];
-    }
+                                 : kernels_.linear_of_upsampled(kernels_.upsample(prev0, prev1, col, row.upper, ch));
   }
   FrameTally& t = out.tally;
   bool underflow = false;
@@ -951,9 +960,8 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   t.counts.weight_underflow += underflow ? 1 : 0;
   for (int ch = 0; ch < 3; ++ch) {
     const Raw residual = residual_zero ? 0 : residual_row[3 * x + ch];
-    const WeightedSample s = residual_zero && tie_correction[ch] == 0
-                                 ? kernels_.clamp_alpha(alpha[ch])
-                                 : kernels_.add_weighted_residual(alpha[ch], weight, residual, tie_correction[ch]);  // Eq. 4
+    const WeightedSample s = residual_zero ? kernels_.clamp_alpha(alpha[ch])
+                                           : kernels_.add_weighted_residual(alpha[ch], weight, residual);  // Eq. 4
     t.clipped += s.clipped ? 1 : 0;
     t.counts.alpha_clipped += s.clipped ? 1 : 0;
     t.dropped_sum += s.dropped;
@@ -988,11 +996,7 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
   add(FixedStage::Codes, "codes", code, b, false, full ? g.full : g.reduced, 3);
   if (full) {
     add(FixedStage::Linear, "I", linear, 1 + F, false, g.full, 3);
-    if (kernels_.linear_space()) {
-      add(FixedStage::Reduced, "d", code, b, false, g.reduced, 3);
-    } else {
-      add(FixedStage::Reduced, "d", code + " + exact-tie flag in bit " + std::to_string(b), b + 1, false, g.reduced, 3);
-    }
+    add(FixedStage::Reduced, "d", code, b, false, g.reduced, 3);
     add(FixedStage::LowPass, "L", linear, 1 + F, false, g.full, 3);
     add(FixedStage::Beta, "beta", "sQ3." + std::to_string(F), 3 + F, true, g.full, 3);
     add(FixedStage::Shown, "shown", linear, 1 + F, false, g.full, 3);
@@ -1070,7 +1074,7 @@ cv::Mat FixedDecoderCore::concealed_codes(const cv::Mat& codes, const Concealmen
     std::uint16_t* row = out.ptr<std::uint16_t>(y);
     if (!c.substitute.empty()) {
       const std::uint16_t* stored = c.substitute.ptr<std::uint16_t>(y);
-      for (int i = 0; i < samples; ++i) row[i] = code_of(stored[i]);
+      std::copy(stored, stored + samples, row);
       continue;
     }
     // The nearest intact line above, else (lines above the first intact one) below. Lines above y are already
@@ -1082,10 +1086,7 @@ cv::Mat FixedDecoderCore::concealed_codes(const cv::Mat& codes, const Concealmen
 }
 
 DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
-  if (meta.eye < 0) throw std::invalid_argument(std::string(who) + ": eye must be >= 0");
-  if (meta.full_width < 1 || meta.full_height < 1) {
-    throw std::invalid_argument(std::string(who) + ": full size must be at least 1x1");
-  }
+  check_view_meta(meta, std::string(who).append(": lost view: "));
   const cv::Size full(meta.full_width, meta.full_height);
   EyeState& eye = eyes_[meta.eye];
   DecodedFrame out;

@@ -21,18 +21,6 @@ using Raw = std::int64_t;
 // Round half up (SC_RND) of v / 2^shift; C++20 >> on negative values is arithmetic, so this holds for any sign.
 inline Raw round_shift(Raw v, int shift) { return shift <= 0 ? v * (Raw{1} << -shift) : (v + (Raw{1} << (shift - 1))) >> shift; }
 
-// The d_t frame store keeps one flag bit beside each code (codes are at most 10 bits): set where D(E_t) fell exactly
-// half-way between d and d - 1. The encoder's double D rounds such ties by floating-point noise, so the reduced
-// frame that follows may carry either code; the motion test then takes the one received (resolve_tie), keeping
-// static content static (DESIGN §4: "c = 0 when nothing moved"), and the difference between the low-pass the full
-// frame used and the resolved one joins the residual (so alpha + beta = 2 I still holds, Eq. 3).
-inline constexpr std::uint16_t kTieFlag = 0x8000;
-inline std::uint16_t code_of(std::uint16_t stored) { return static_cast<std::uint16_t>(stored & ~kTieFlag); }
-inline Raw resolve_tie(std::uint16_t stored, std::uint16_t received) {
-  const Raw code = code_of(stored);
-  return (stored & kTieFlag) != 0 && received + 1 == code ? code - 1 : code;
-}
-
 // Round half to even (SC_RND_CONV) of v / 2^shift, shift >= 1. Used where two values that sum to an integer must
 // still do so after rounding (complementary rows of a Nyquist pattern in the D line buffer).
 inline Raw round_convergent_shift(Raw v, int shift) {
@@ -127,9 +115,9 @@ class FixedKernels {
   // D, horizontal half: sum_i w_i E_i over one row of codes (channel ch of interleaved RGB), uQb.L (L = line bits).
   // Linear space: sum_i w_i lin(E_i), uQ1.P.
   Raw gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const;
-  // D, vertical half, and Q_b: d = round(sum_j w_j h_j) where rows[j] is the line buffer row of tap j; a link code,
-  // with kTieFlag set when the sum was exactly half-way (strip it with code_of for arithmetic). Linear space: the sum
-  // rounded to uQ1.P and re-encoded through the threshold ROM (never flagged).
+  // D, vertical half, and Q_b: d = round(sum_j w_j h_j) where rows[j] is the line buffer row of tap j, a link code;
+  // an exact half-code tie rounds up, as the encoder's quantise_reduced does. Linear space: the sum rounded to uQ1.P
+  // and re-encoded through the threshold ROM (thresholds from quantise_reduced).
   std::uint16_t gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const;
   // Linear space: the link code the encoder gives linear value x (uQ1.P): the largest k with x >= T_k.
   std::uint16_t encode_linear(Raw x) const;
@@ -139,13 +127,6 @@ class FixedKernels {
   // U: bilinear blend of reduced codes rows row0 (i0) and row1 (i1) at full column x, channel ch; codes uQb.U.
   Raw upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col, Raw row_upper,
                int ch) const;
-  // U of the stored d_{t-1} for the motion test, each sample's exact tie resolved towards the received code.
-  Raw upsample_previous(const std::uint16_t* stored0, const std::uint16_t* stored1, const std::uint16_t* received0,
-                        const std::uint16_t* received1, const BilinearWeights& col, Raw row_upper, int ch) const;
-  // U of the stored d_t codes as the full frame used them (tie flags stripped), and whether any of the four had a tie.
-  Raw upsample_stored(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col,
-                      Raw row_upper, int ch) const;
-  bool has_tie(const std::uint16_t* stored0, const std::uint16_t* stored1, const BilinearWeights& col, int ch) const;
   // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd); linear space: four codes through
   // the I ROM, result uQ1.F (Rnd).
   Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
@@ -171,18 +152,15 @@ class FixedKernels {
   Raw motion_weight(Raw luma_previous, Raw luma_alpha, bool& underflow) const;
   // Eq. 5 alone (the c that motion_weight computes, for test vectors): uQ1.F, 0 where Yp = Ya.
   Raw motion_contrast(Raw luma_previous, Raw luma_alpha) const;
-  // Eq. 4: alpha' = clamp(alpha + w (rho + tie_correction), 0, 1); tie_correction = L_used - L_resolved (uQ.F).
-  WeightedSample add_weighted_residual(Raw alpha, Raw weight, Raw residual, Raw tie_correction) const;
+  // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1).
+  WeightedSample add_weighted_residual(Raw alpha, Raw weight, Raw residual) const;
   // Eq. 4 on a line with no residual (DESIGN §7 skip): alpha' = clamp(alpha, 0, 1), what add_weighted_residual gives
-  // for rho = 0 and no tie correction.
+  // for rho = 0.
   WeightedSample clamp_alpha(Raw alpha) const;
 
   // The line comparator of the static skip (DESIGN §7): a received reduced line i(k) against the stored d_{t-1} row
-  // k, `samples` channel samples. kLineStatic: every code equals the stored one with its exact tie resolved towards
-  // the received code (so U of the two is the same); kLineTie: some stored code differs from the received one only
-  // by that tie resolution (the tie correction of Eq. 4 is not zero there).
+  // k, `samples` channel samples. kLineStatic: every code equals the stored one (so U of the two is the same).
   static constexpr std::uint8_t kLineStatic = 1;
-  static constexpr std::uint8_t kLineTie = 2;
   static std::uint8_t compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples);
 
   // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
@@ -245,7 +223,7 @@ struct EyeState {
   bool have_residual = false;
   std::int64_t residual_index = 0;
   cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
-  cv::Mat previous_low;   // d_t codes with kTieFlag, reduced size, CV_16UC3
+  cv::Mat previous_low;   // d_t codes, reduced size, CV_16UC3
   std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
   DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
                              // view is lost
@@ -259,7 +237,7 @@ struct Concealment {
   std::span<const std::uint8_t> intact;  // one entry per line of the view; 0 = lost
   int first_intact = 0;  // lost lines above it have no intact line above: they take this line's content
   int lost_lines = 0;
-  cv::Mat substitute;    // reduced frames: the eye's d_{t-1} frame store (codes with kTieFlag); empty: none
+  cv::Mat substitute;    // reduced frames: the eye's d_{t-1} frame store (codes); empty: none
   bool lost(int y) const { return intact[static_cast<std::size_t>(y)] == 0; }
 };
 
@@ -267,7 +245,6 @@ struct Concealment {
 // flags of its U source rows and the full frame's residual line flag.
 struct ReducedLineGate {
   bool motion_static = false;  // L_{t-1} = alpha on the whole line: w = 1, no motion test
-  bool tie_rows = false;       // static, but a source row's tie makes the tie correction nonzero somewhere
   bool residual_zero = false;  // rho all zero on the line: no residual read, no add
 };
 
@@ -315,8 +292,8 @@ class FixedDecoderCore {
                   bool lost = false) const;
   // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
   // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
-  // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are read only when
-  // tie_rows); residual_zero reads no residual (residual_row may then be null) and adds nothing.
+  // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are not read);
+  // residual_zero reads no residual (residual_row may then be null) and adds nothing.
   void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
                      const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
                      const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr) const;
@@ -336,7 +313,6 @@ class FixedDecoderCore {
     const std::uint8_t f1 = row.upper == 0 ? static_cast<std::uint8_t>(FixedKernels::kLineStatic) : row_flags(row.i1);
     ReducedLineGate gate;
     gate.motion_static = (f0 & f1 & FixedKernels::kLineStatic) != 0;
-    gate.tie_rows = gate.motion_static && ((f0 | (row.upper == 0 ? 0 : f1)) & FixedKernels::kLineTie) != 0;
     gate.residual_zero = eye.residual_nonzero.size() == static_cast<std::size_t>(g.full.height) &&
                          eye.residual_nonzero[static_cast<std::size_t>(y)] == 0;
     out.tally.counts.motion_test_lines_skipped += gate.motion_static ? 1 : 0;

@@ -144,11 +144,10 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
   r.reduced = g.reduced;
   r.roms = core_->kernels().roms();
   r.arithmetic = core_->kernels().arithmetic(g);
-  // The linear resample space keeps D's horizontal results as linear light (uQ1.P) and d_t without the exact-tie
-  // flag (there are no exact half-code ties to resolve).
+  // The linear resample space keeps D's horizontal results as linear light (uQ1.P). d_t is b-bit link codes in both.
   const bool linear = c.decoder.link.resample_space == ResampleSpace::Linear;
   const int gauss_bits = linear ? 1 + c.linear_resample_frac_bits : b + c.gaussian_line_frac_bits;
-  const int low_bits = linear ? b : b + 1;
+  const int low_bits = b;
   r.buffers = {
       {linear ? "line: vertical Gaussian (horizontal D results, linear uQ1." +
                     std::to_string(c.linear_resample_frac_bits) + ")"
@@ -158,9 +157,7 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
       {"line: U of d_t (full frames, codes)", p.low_lines, 3 * g.reduced.width, b},
       {"line: U of i (reduced frames, codes)", p.reduced_lines, 3 * g.reduced.width, b},
       {"frame: residual rho (" + c.residual.to_string() + ")", g.full.height, 3 * g.full.width, c.residual.width()},
-      {linear ? std::string("frame: d_t for the motion test (codes)")
-              : std::string("frame: d_t for the motion test (codes + exact-tie flag)"),
-       g.reduced.height, 3 * g.reduced.width, low_bits},
+      {"frame: d_t for the motion test (codes)", g.reduced.height, 3 * g.reduced.width, low_bits},
   };
   const std::int64_t full_samples = 3 * static_cast<std::int64_t>(g.full.area());
   const std::int64_t reduced_samples = 3 * static_cast<std::int64_t>(g.reduced.area());
@@ -185,9 +182,9 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
                     3 * g.full.width, c.decoder.output_bits);
   }
   if (c.skip_unneeded) {
-    // DESIGN §7 skips: the line comparator's static / tie flags beside the U buffer of i, and one residual-nonzero
+    // DESIGN §7 skips: the line comparator's static flag beside the U buffer of i, and one residual-nonzero
     // bit per full line (the only storage the skips add; OLED already keeps no LCD stores).
-    add_frame_store("line: U of i comparator flags (static, exact tie) vs d_{t-1}", p.reduced_lines, 1, 2);
+    add_frame_store("line: U of i comparator flag (static) vs d_{t-1}", p.reduced_lines, 1, 1);
     add_frame_store("frame: residual-nonzero line flags (rho write / read gate)", g.full.height, 1, 1);
     FixedArithmeticReport& compare = r.arithmetic.emplace_back();
     compare.stage = "line comparator i vs d_{t-1} (static skip)";
@@ -303,7 +300,7 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
           std::uint16_t* stored = low_store.ptr<std::uint16_t>(k);
           for (int i = 0; i < reduced_samples; ++i) {
             stored[i] = kernels.gaussian_vertical(tap_rows.data(), taps, i);
-            d[i] = fixed_detail::code_of(stored[i]);
+            d[i] = stored[i];
           }
         },
         [&](int y, int, int) {
@@ -326,7 +323,8 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
     return core_->finish(std::move(out), eye, true, false);
   }
 
-  const bool residual_applies = eye.have_residual && eye.residual_index + 1 == frame.meta.index;
+  // frame.meta.index >= 0 (checked by begin), so index - 1 cannot overflow.
+  const bool residual_applies = eye.have_residual && eye.residual_index == frame.meta.index - 1;
   LineRing<std::uint16_t> in_lines("U of i", plan.reduced_lines, reduced_samples);
   // DESIGN §7 static skip: the line comparator's result for each line held in the U buffer (2 bits per line).
   const bool gated = residual_applies && core_->skipping();
@@ -340,8 +338,7 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
           std::copy(in, in + reduced_samples, in_lines.write(k));
         } else if (!lost->substitute.empty()) {
           const std::uint16_t* stored = lost->substitute.ptr<std::uint16_t>(k);  // d_{t-1} frame store row k
-          std::uint16_t* line = in_lines.write(k);
-          for (int i = 0; i < reduced_samples; ++i) line[i] = fixed_detail::code_of(stored[i]);
+          std::copy(stored, stored + reduced_samples, in_lines.write(k));
         } else {
           repeat_line(in_lines, k, reduced_samples);
         }
@@ -361,7 +358,7 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fi
             return k < first ? 0 : *line_flags.read(k);
           });
         }
-        const bool read_previous = residual_applies && (!gate.motion_static || gate.tie_rows);
+        const bool read_previous = residual_applies && !gate.motion_static;
         const std::uint16_t* prev0 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
         const std::uint16_t* prev1 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
         const std::int32_t* residual_row =

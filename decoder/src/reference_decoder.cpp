@@ -40,10 +40,30 @@ std::string frame_name(const FrameMeta& meta) {
 // ---------------------------------------------------------------------------------------------------------
 // Input checks: everything the stages below rely on.
 
+// The metadata every view needs, also a lost one: index, eye and the size of the view it reconstructs to. The
+// residual adjacency test compares residual_index with index - 1, which needs index >= 0 (no overflow).
+void check_view_meta(const FrameMeta& meta, const std::string& what) {
+  if (meta.index < 0) throw std::invalid_argument(what + "frame index must be >= 0");
+  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
+  if (meta.full_width < 1 || meta.full_height < 1 || meta.full_width > kMaxViewSide ||
+      meta.full_height > kMaxViewSide) {
+    std::string message = what;
+    message.append("full size must be at least 1x1 and at most ")
+        .append(std::to_string(kMaxViewSide))
+        .append("x")
+        .append(std::to_string(kMaxViewSide))
+        .append(", got ")
+        .append(std::to_string(meta.full_width))
+        .append("x")
+        .append(std::to_string(meta.full_height));
+    throw std::invalid_argument(message);
+  }
+}
+
 void check_link_frame(const LinkFrame& frame, const DecoderConfig& config) {
   const FrameMeta& meta = frame.meta;
   const std::string what = "ReferenceDecoder: " + frame_name(meta) + ": ";
-  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
+  check_view_meta(meta, what);
   if (meta.bits != config.link.bits) {
     throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
                                 std::to_string(config.link.bits));
@@ -51,9 +71,6 @@ void check_link_frame(const LinkFrame& frame, const DecoderConfig& config) {
   if (meta.transfer != config.link.transfer) {
     throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
                                 to_string(config.link.transfer));
-  }
-  if (meta.full_width < 1 || meta.full_height < 1) {
-    throw std::invalid_argument(what + "full size must be at least 1x1");
   }
   if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
     throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
@@ -481,6 +498,7 @@ int conceal_rows(cv::Mat& codes, std::span<const std::uint8_t> intact, const cv:
 }  // namespace
 
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
+  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(frame_name(meta)).append(": "));
   const cv::Size full(meta.full_width, meta.full_height);
   EyeState& eye = eyes_[meta.eye];
   DecodedFrame out;
@@ -598,7 +616,8 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     }
   } else {
     const cv::Mat alpha = upsampled_linear(frame.codes, full, link);  // Eq. 1
-    const bool residual_applies = eye.have_residual && eye.residual_index + 1 == meta.index;
+    // meta.index >= 0 (check_link_frame), so index - 1 cannot overflow.
+    const bool residual_applies = eye.have_residual && eye.residual_index == meta.index - 1;
     if (residual_applies) {
       // The design keeps only the reduced-size d_t: L_prev is recomputed from it, bit-identical to L_t.
       const cv::Mat previous_low_linear = upsampled_linear(eye.previous_low, full, link);

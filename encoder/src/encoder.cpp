@@ -20,6 +20,14 @@ void EncoderConfig::validate() const {
   if (std::isnan(sigma) || sigma < 0.0 || !std::isfinite(sigma)) {
     throw std::invalid_argument("sigma must be > 0 when given (0 selects 1.25 / r), got " + std::to_string(sigma));
   }
+  if (effective_sigma() > kMaxSigma) {
+    std::string message = "sigma must be <= ";
+    message.append(std::to_string(kMaxSigma))
+        .append(" full-resolution pixels (D's rounding error must stay below the reduced frame's tie tolerance), got ")
+        .append(std::to_string(effective_sigma()));
+    if (sigma == 0.0) message.append(" (the default 1.25 / r at r = ").append(std::to_string(reduction)).append(")");
+    throw std::invalid_argument(message);
+  }
   if (bits != 8 && bits != 10) throw std::invalid_argument("link bits must be 8 or 10, got " + std::to_string(bits));
   if (phase != 0 && phase != 1) throw std::invalid_argument("phase must be 0 or 1, got " + std::to_string(phase));
   if (transfer != Transfer::Srgb && transfer != Transfer::Gamma22) throw std::invalid_argument("unknown transfer function");
@@ -43,15 +51,20 @@ cv::Mat reduce_codes(const cv::Mat& full_codes, const EncoderConfig& config) {
   if (full_codes.depth() != CV_16U || full_codes.empty()) {
     throw std::invalid_argument("reduce_codes: expected non-empty CV_16U link codes");
   }
+  if (full_codes.cols > kMaxViewSide || full_codes.rows > kMaxViewSide) {
+    throw std::invalid_argument("reduce_codes: the view is " + std::to_string(full_codes.cols) + "x" +
+                                std::to_string(full_codes.rows) + ", at most " + std::to_string(kMaxViewSide) +
+                                " per side is supported");
+  }
   const int w = reduced_size(full_codes.cols, config.reduction);
   const int h = reduced_size(full_codes.rows, config.reduction);
   const double sigma = config.effective_sigma();
   const cv::Mat encoded = dequantise(full_codes, config.bits);
   if (config.resample_space == ResampleSpace::Encoded) {
-    return quantise(downsample(encoded, w, h, sigma), config.bits);  // Q_b(D(E))
+    return quantise_reduced(downsample(encoded, w, h, sigma), config.bits);  // Q_b(D(E))
   }
   const cv::Mat linear_reduced = downsample(to_linear(encoded, config.transfer), w, h, sigma);
-  return quantise(to_encoded(linear_reduced, config.transfer), config.bits);  // Q_b(enc(D(lin(E))))
+  return quantise_reduced(to_encoded(linear_reduced, config.transfer), config.bits);  // Q_b(enc(D(lin(E))))
 }
 
 TrmEncoder::TrmEncoder(EncoderConfig config) : config_(config) { config_.validate(); }
@@ -59,6 +72,11 @@ TrmEncoder::TrmEncoder(EncoderConfig config) : config_(config) { config_.validat
 LinkFrame TrmEncoder::encode(const cv::Mat& linear_full, std::int64_t t, int eye) const {
   if (linear_full.type() != CV_64FC3 || linear_full.empty()) {
     throw std::invalid_argument("encode: expected a non-empty CV_64FC3 linear RGB frame");
+  }
+  if (linear_full.cols > kMaxViewSide || linear_full.rows > kMaxViewSide) {
+    throw std::invalid_argument("encode: frame " + std::to_string(t) + " is " + std::to_string(linear_full.cols) +
+                                "x" + std::to_string(linear_full.rows) + ", at most " + std::to_string(kMaxViewSide) +
+                                " per side is supported");
   }
   if (!cv::checkRange(linear_full, true, nullptr, 0.0, 1.0 + 1e-12)) {
     throw std::invalid_argument("encode: frame " + std::to_string(t) + " has NaN, Inf or values outside [0, 1]");

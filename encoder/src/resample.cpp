@@ -82,6 +82,11 @@ double reduced_centre(int x_low, int full, int reduced) {
 
 int gaussian_radius(double sigma) {
   require_sigma(sigma);
+  // R must fit an int with room for the tap arithmetic (EncoderConfig bounds sigma far lower, kMaxSigma).
+  if (sigma > 1e8) {
+    throw std::invalid_argument("Gaussian sigma must be <= 1e8 (R = ceil(3 sigma) as an int), got " +
+                                std::to_string(sigma));
+  }
   // R = ceil(3 sigma). sigma usually arrives as 1.25 / r, whose last-bit rounding can push 3 sigma just
   // above an integer (e.g. 5.000000000000001); a relative slack of 1e-12 keeps such cases at the
   // intended integer without affecting any sigma that is meaningfully above it.
@@ -100,11 +105,18 @@ GaussianTaps gaussian_taps(int x_low, int full, int reduced, double sigma) {
   GaussianTaps taps;
   taps.first_index = static_cast<int>(first);
   taps.weights.reserve(static_cast<std::size_t>(last - first + 1));
+  // Every weight relative to the largest (the tap nearest c): exp(-((i - c)^2 - d^2) / 2 sigma^2) with d the
+  // nearest tap's distance. The normalised taps are the same Gaussian, but the sum is >= 1 for every sigma > 0, so
+  // a sigma far below a pixel (where every absolute weight exp(-(i - c)^2 / 2 sigma^2) underflows to 0) cannot
+  // make it 0 / 0. Mirror-image taps keep equal weights.
+  std::int64_t nearest = std::abs(first * den - num);
+  for (std::int64_t i = first + 1; i <= last; ++i) nearest = std::min(nearest, std::abs(i * den - num));
+  const double nearest_offset = static_cast<double>(nearest) / static_cast<double>(den);
   const double inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
   double sum = 0.0;
   for (std::int64_t i = first; i <= last; ++i) {
     const double offset = static_cast<double>(i * den - num) / static_cast<double>(den);  // i - c
-    const double w = std::exp(-offset * offset * inv_two_sigma2);
+    const double w = std::exp(-(offset * offset - nearest_offset * nearest_offset) * inv_two_sigma2);
     taps.weights.push_back(w);
     sum += w;
   }

@@ -90,6 +90,27 @@ cv::Mat quantise(const cv::Mat& values, int bits) {
   return codes;
 }
 
+std::uint16_t quantise_reduced(double value, int bits) {
+  require_bits(bits);
+  if (std::isnan(value)) throw std::invalid_argument("quantise_reduced: NaN value");
+  const double max_code = static_cast<double>((1 << bits) - 1);
+  // clamp01(value) max_code + 1/2 + tol < max_code + 1: the top code cannot be exceeded.
+  return static_cast<std::uint16_t>(std::floor(clamp01(value) * max_code + 0.5 + kReducedTieTolerance));
+}
+
+cv::Mat quantise_reduced(const cv::Mat& values, int bits) {
+  require_double(values, "quantise_reduced");
+  require_bits(bits);
+  cv::Mat codes(values.size(), CV_MAKETYPE(CV_16U, values.channels()));
+  const int row_len = values.cols * values.channels();
+  for (int y = 0; y < values.rows; ++y) {
+    const double* src = values.ptr<double>(y);
+    std::uint16_t* dst = codes.ptr<std::uint16_t>(y);
+    for (int i = 0; i < row_len; ++i) dst[i] = quantise_reduced(src[i], bits);
+  }
+  return codes;
+}
+
 cv::Mat dequantise(const cv::Mat& codes, int bits) {
   if (codes.depth() != CV_16U) throw std::invalid_argument("dequantise: expected a CV_16U matrix");
   require_bits(bits);

@@ -174,8 +174,8 @@ TEST(FixedDecoder, AgreesWithReferenceAcrossSensitivities) {
   }
 }
 
-// Eq. 3 in fixed point: for static content the reduced frame sees c = 0 (w = 1 exactly, also where the encoder's
-// double D rounded an exact half-code tie either way: the Nyquist checkerboard), and wherever alpha' is not clipped
+// Eq. 3 in fixed point: for static content the reduced frame sees c = 0 (w = 1 exactly, also where D lands on an
+// exact half-code tie, which both sides round up: the Nyquist checkerboard), and wherever alpha' is not clipped
 // the pair sums to 2 I within the rounding of the I ROM.
 TEST(FixedDecoder, StaticContentIsRecoveredExactly) {
   for (const std::string& name : {std::string("checker"), std::string("static"), std::string("text")}) {

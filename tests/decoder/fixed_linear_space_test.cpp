@@ -153,7 +153,7 @@ TEST(FixedLinearSpace, ReportsLinearLineBufferAndReEncodingRom) {
     return b.name.rfind("frame: d_t", 0) == 0;
   });
   ASSERT_NE(d_store, r.buffers.end());
-  EXPECT_EQ(d_store->bits, 8);  // no exact-tie flag
+  EXPECT_EQ(d_store->bits, 8);  // link codes
   const auto has_rom = [&](const std::string& prefix) {
     return std::any_of(r.roms.begin(), r.roms.end(),
                        [&](const FixedRomReport& rom) { return rom.name.rfind(prefix, 0) == 0; });

@@ -116,11 +116,11 @@ TEST(FixedHardwareReport, RomsArithmeticAndFrameStores) {
     EXPECT_EQ(has_lcd_rom, std::string(panel) == "lcd");
     ASSERT_FALSE(r.arithmetic.empty());
     for (const auto& a : r.arithmetic) EXPECT_GT(a.evaluations, 0) << a.stage;
-    // Paper: full previous frame (8 bits) + residual; here: reduced d_t (9 bits) + residual.
+    // Paper: full previous frame (8 bits) + residual; here: reduced d_t (8-bit link codes) + residual.
     const std::int64_t full = 3LL * 1080 * 1200;
     const std::int64_t reduced = 3LL * 540 * 600;
     EXPECT_EQ(r.paper_frame_store_bits, full * 8 + full * 26);
-    EXPECT_EQ(r.model_frame_store_bits, reduced * 9 + full * 26);
+    EXPECT_EQ(r.model_frame_store_bits, reduced * 8 + full * 26);
   }
 }
 

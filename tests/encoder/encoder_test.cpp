@@ -101,9 +101,9 @@ TEST(TrmEncoder, ReducedFrameIsQofDofTheQuantisedFullFrame) {
     const cv::Mat e = dequantise(full.codes, 8);
     cv::Mat expected;
     if (space == ResampleSpace::Encoded) {
-      expected = quantise(downsample(e, 49, 31, 2.5), 8);
+      expected = quantise_reduced(downsample(e, 49, 31, 2.5), 8);
     } else {
-      expected = quantise(to_encoded(downsample(to_linear(e, Transfer::Srgb), 49, 31, 2.5), Transfer::Srgb), 8);
+      expected = quantise_reduced(to_encoded(downsample(to_linear(e, Transfer::Srgb), 49, 31, 2.5), Transfer::Srgb), 8);
     }
     EXPECT_EQ(cv::norm(reduced.codes, expected, cv::NORM_INF), 0.0) << to_string(space);
     EXPECT_EQ(cv::norm(reduce_codes(full.codes, c), expected, cv::NORM_INF), 0.0);

@@ -100,7 +100,7 @@ Json hardware_json(const FixedStreamingReport& r) {
   hw["concealment"] = r.concealment;
   hw["paper_comparison"] = {
       {"description", "paper Sec. 9: full-size previous frame (link codes) + full-size residual; this model: "
-                      "reduced-size d_t (codes, + exact-tie flag in the encoded resample space) + full-size residual (LCD stores and the held output for "
+                      "reduced-size d_t (link codes) + full-size residual (LCD stores and the held output for "
                       "lost views excluded from both)"},
       {"paper_frame_store_bits", r.paper_frame_store_bits},
       {"model_frame_store_bits", r.model_frame_store_bits},

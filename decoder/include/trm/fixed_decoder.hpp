@@ -40,11 +40,15 @@ struct FixedDecoderConfig {
 
   // D (polyphase Gaussian): taps uQ0.F, per reduced sample summing exactly to 2^F (largest remainder, mirror
   // symmetric where the taps are). d_t must reproduce the encoder's reduced frame code for code (a differing code
-  // reads as motion, Eq. 5). Measured against the reference over every scene and noise at r in {1, .75, .5, .4, .25}:
+  // reads as motion, Eq. 5). Q_b rounds to the nearest code with exact half-code ties up, as the encoder's
+  // quantise_reduced does (it counts a double D within 1e-9 code of a half as the half, so the encoder's rounding
+  // noise cannot break a tie either way); mirror-symmetric taps and the half-to-even line buffer keep the ties of
+  // symmetric content (Nyquist checkerboards, two codes averaged) exact here, so both round them up. Measured against the reference over every scene and noise at r in {1, .75, .5, .4, .25}:
   // Q0.14: 0.064 % of output codes differ, up to 28 LSB; Q0.16: 0.015 %, 7 LSB; Q0.20: 0.004 %, 3 LSB;
   // Q0.24: 0.0015 %, 1 LSB.
   int gaussian_tap_frac_bits = 24;
-  // The horizontal D result as the vertical line buffer holds it: codes uQb.F, rounded half to even (RndConv).
+  // The horizontal D result as the vertical line buffer holds it: codes uQb.F, rounded half to even (RndConv: two
+  // rows that sum to an integer still do after rounding, so an exact tie of the vertical sum stays exact).
   int gaussian_line_frac_bits = 16;
 
   // D in the linear resample space (link.resample_space == ResampleSpace::Linear, the encoder's Q_b(enc(D(lin(E))))):
@@ -53,8 +57,8 @@ struct FixedDecoderConfig {
   // vertical result in uQ1.P (rounded half up). d_t is re-encoded to link codes by a threshold ROM (2^b words of
   // uQ1.P; T_k is the smallest grid value the encoder's floor(enc(x) (2^b - 1) + 1/2) quantises to k or above) and a
   // b-step binary search: exactly the encoder's quantiser for every value on the grid, so d_t differs from the
-  // encoder's reduced frame only where D's rounding puts the value on the other side of a threshold. There are no
-  // exact half-code ties to flag (the d_t store holds b-bit codes).
+  // encoder's reduced frame only where D's rounding puts the value on the other side of a threshold. The thresholds
+  // follow quantise_reduced (ties, and values within its tolerance of a half code, round up).
   // Wider than the encoded space's D formats: in linear light the code steps near black are narrow (gamma 2.2 at 10
   // bits: 2^-21 between the first thresholds), and a d_t code that differs from the encoder's reads as motion in
   // Eq. 5. d_t codes differing from the encoder's, over every scene and noise at r in {1, .75, .5, .4, .25}, sRGB and
@@ -199,14 +203,14 @@ struct FixedStreamingReport {
 enum class FixedStage {
   Codes,           // received link codes (full size for full frames, reduced size for reduced frames)
   Linear,          // full: I = lin(E_t)
-  Reduced,         // full: d_t = Q_b(D(E_t)) as the frame store holds it (exact-tie flag in bit b; linear space:
-                   // Q_b(enc(D(lin(E_t)))), no flag)
+  Reduced,         // full: d_t = Q_b(D(E_t)) as the frame store holds it, link codes (exact ties rounded up;
+                   // linear space: Q_b(enc(D(lin(E_t)))))
   LowPass,         // full: L = lin(U(d_t)) (linear space: U(lin(d_t)))
   Beta,            // full: beta = 2 I - L
   Shown,           // full: clamp(beta, 0, 1)
   Residual,        // full: rho (plus any LCD shortfall) in the residual store format
   Alpha,           // reduced: alpha = lin(U(i))
-  PreviousLowPass, // reduced: L_{t-1} = lin(U(d_{t-1})) for the motion test (exact ties resolved)
+  PreviousLowPass, // reduced: L_{t-1} = lin(U(d_{t-1})) for the motion test
   Contrast,        // reduced: motion contrast c (per pixel)
   Weight,          // reduced: w = exp(-s c) (per pixel)
   AlphaPrime,      // reduced: alpha' = clamp(alpha + w rho, 0, 1) (clamp(alpha) without a residual)

@@ -14,6 +14,12 @@ namespace trm {
 
 enum class Parity : std::uint8_t { Full = 0, Reduced = 1 };
 
+// The largest view side the encoder and the decoders accept (pixels). A frame's metadata claims the size of the view
+// it reconstructs to; the decoders build taps and frame stores of that size, so a corrupted header must be rejected
+// before anything of that size is allocated. 65535 is what a 16-bit line or column counter addresses (far above any
+// headset panel), and keeps every index product of the resampling arithmetic ((2x + 1) W, 3 W H) well inside 64 bits.
+inline constexpr int kMaxViewSide = 65535;
+
 enum class Transfer : std::uint8_t { Srgb = 0, Gamma22 = 1 };
 
 // Space in which D and U act (DESIGN §3): encoded values (default, paper Sec. 4.2) or linear.

@@ -3,6 +3,8 @@
 
 #include "trm/frame.hpp"
 
+#include <cstdint>
+
 namespace trm {
 
 // Encoded value -> linear light, and back. Inputs outside [0, 1] are clamped first.
@@ -13,6 +15,21 @@ cv::Mat to_encoded(const cv::Mat& linear, Transfer transfer);
 
 // q = floor(x * (2^bits - 1) + 0.5) after clamping x to [0, 1]; returns CV_16U with the same channels.
 cv::Mat quantise(const cv::Mat& values, int bits);
+// Q_b of the reduced frame (DESIGN §3 quantisation, deterministic at exact half-code ties). D of symmetric content
+// lands exactly on k + 1/2 codes (two codes averaged, a Nyquist checkerboard, an edge midway between two rows); D in
+// doubles lands within its rounding error of that half, on either side by floating-point noise, and floor(v + 1/2)
+// would round such a tie either way from sample to sample. Here a value within kReducedTieTolerance of a half code
+// counts as the half, and halves round up: q = floor(v + 1/2 + tol) with v = clamp(x, 0, 1) (2^bits - 1).
+// The tolerance: D is two passes of normalised Gaussian taps over values <= 1; its double rounding error (the tap
+// sums, the normalisation and the two dot products) is below 4 n u (2^b - 1) codes for n taps per axis and
+// u = 2^-53: 7.7e-12 codes at the default sigma = 2.5 (n = 17, 10-bit link), ~1e-13 in practice, and 7.0e-10 at the
+// largest sigma EncoderConfig accepts (kMaxSigma, n = 1537). 1e-9 code lies above that worst case and far below any
+// difference the link can carry (a code is 1; the fixed-point decoder's D resolves 2^-40 codes and rounds exact ties
+// up, so both sides agree on every tie). A value that is not a tie but within 1e-9 code of a half is rounded up too.
+inline constexpr double kReducedTieTolerance = 1e-9;
+std::uint16_t quantise_reduced(double value, int bits);
+// The same for every element: CV_64F in, CV_16U with the same channels out; NaN is rejected.
+cv::Mat quantise_reduced(const cv::Mat& values, int bits);
 // code / (2^bits - 1), CV_64F.
 cv::Mat dequantise(const cv::Mat& codes, int bits);
 
