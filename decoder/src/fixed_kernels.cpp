@@ -755,27 +755,6 @@ FixedDecoderCore::FixedDecoderCore(FixedDecoderConfig config) : kernels_(config)
 
 namespace {
 
-// The metadata every view needs, also a lost one (as the reference checks it): index (the residual adjacency test
-// compares the stored index with index - 1, which needs index >= 0), eye, and a view size within kMaxViewSide, so
-// that a corrupted header is rejected before taps or frame stores of that size are built.
-void check_view_meta(const FrameMeta& meta, const std::string& what) {
-  if (meta.index < 0) throw std::invalid_argument(what + "frame index must be >= 0");
-  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
-  if (meta.full_width < 1 || meta.full_height < 1 || meta.full_width > kMaxViewSide ||
-      meta.full_height > kMaxViewSide) {
-    std::string message = what;
-    message.append("full size must be at least 1x1 and at most ")
-        .append(std::to_string(kMaxViewSide))
-        .append("x")
-        .append(std::to_string(kMaxViewSide))
-        .append(", got ")
-        .append(std::to_string(meta.full_width))
-        .append("x")
-        .append(std::to_string(meta.full_height));
-    throw std::invalid_argument(message);
-  }
-}
-
 std::string size_text(int width, int height) { return std::to_string(width).append("x").append(std::to_string(height)); }
 
 }  // namespace
@@ -1089,23 +1068,12 @@ DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* wh
   check_view_meta(meta, std::string(who).append(": lost view: "));
   const cv::Size full(meta.full_width, meta.full_height);
   EyeState& eye = eyes_[meta.eye];
-  DecodedFrame out;
-  if (eye.full_size == full && !eye.last_output.drive.empty()) {
-    out = eye.last_output;
-  } else {
+  const bool held = eye.full_size == full && !eye.last_output.drive.empty();
+  if (!held) {
     eye = EyeState();
     eye.full_size = full;
-    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
-    out.drive = cv::Mat::zeros(full, CV_64FC3);
-    out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
-    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
   }
-  out.meta = meta;
-  out.meta.width = full.width;
-  out.meta.height = full.height;
-  out.stats = FrameStats();
-  out.stats.frame_lost = true;
-  out.stats.concealed_lines = meta.height;
+  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr);
   last_counts_ = FixedStageCounts();
   // The residual belonged to a pair that is now broken (the LCD stores keep the drive the panel still shows).
   eye.have_residual = false;

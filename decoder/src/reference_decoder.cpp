@@ -40,26 +40,6 @@ std::string frame_name(const FrameMeta& meta) {
 // ---------------------------------------------------------------------------------------------------------
 // Input checks: everything the stages below rely on.
 
-// The metadata every view needs, also a lost one: index, eye and the size of the view it reconstructs to. The
-// residual adjacency test compares residual_index with index - 1, which needs index >= 0 (no overflow).
-void check_view_meta(const FrameMeta& meta, const std::string& what) {
-  if (meta.index < 0) throw std::invalid_argument(what + "frame index must be >= 0");
-  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
-  if (meta.full_width < 1 || meta.full_height < 1 || meta.full_width > kMaxViewSide ||
-      meta.full_height > kMaxViewSide) {
-    std::string message = what;
-    message.append("full size must be at least 1x1 and at most ")
-        .append(std::to_string(kMaxViewSide))
-        .append("x")
-        .append(std::to_string(kMaxViewSide))
-        .append(", got ")
-        .append(std::to_string(meta.full_width))
-        .append("x")
-        .append(std::to_string(meta.full_height));
-    throw std::invalid_argument(message);
-  }
-}
-
 void check_link_frame(const LinkFrame& frame, const DecoderConfig& config) {
   const FrameMeta& meta = frame.meta;
   const std::string what = "ReferenceDecoder: " + frame_name(meta) + ": ";
@@ -497,17 +477,13 @@ int conceal_rows(cv::Mat& codes, std::span<const std::uint8_t> intact, const cv:
 
 }  // namespace
 
-DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
-  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(frame_name(meta)).append(": "));
+DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
   const cv::Size full(meta.full_width, meta.full_height);
-  EyeState& eye = eyes_[meta.eye];
   DecodedFrame out;
-  if (eye.full_size == full && !eye.last_output.drive.empty()) {
-    out = eye.last_output;
+  if (last != nullptr) {
+    out = *last;
     out.stages.reset();
   } else {
-    eye = EyeState();
-    eye.full_size = full;
     out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
     out.drive = cv::Mat::zeros(full, CV_64FC3);
     out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
@@ -519,6 +495,19 @@ DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
   out.stats = FrameStats();
   out.stats.frame_lost = true;
   out.stats.concealed_lines = meta.height;
+  return out;
+}
+
+DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
+  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(frame_name(meta)).append(": "));
+  const cv::Size full(meta.full_width, meta.full_height);
+  EyeState& eye = eyes_[meta.eye];
+  const bool held = eye.full_size == full && !eye.last_output.drive.empty();
+  if (!held) {
+    eye = EyeState();
+    eye.full_size = full;
+  }
+  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr);
   // The residual belonged to a pair that is now broken.
   eye.have_residual = false;
   eye.residual.release();

@@ -1,8 +1,27 @@
 #include "trm/frame.hpp"
 
 #include <stdexcept>
+#include <string>
 
 namespace trm {
+
+void check_view_meta(const FrameMeta& meta, const std::string& what) {
+  if (meta.index < 0) throw std::invalid_argument(what + "frame index must be >= 0");
+  if (meta.eye < 0) throw std::invalid_argument(what + "eye must be >= 0");
+  if (meta.full_width < 1 || meta.full_height < 1 || meta.full_width > kMaxViewSide ||
+      meta.full_height > kMaxViewSide) {
+    std::string message = what;
+    message.append("full size must be at least 1x1 and at most ")
+        .append(std::to_string(kMaxViewSide))
+        .append("x")
+        .append(std::to_string(kMaxViewSide))
+        .append(", got ")
+        .append(std::to_string(meta.full_width))
+        .append("x")
+        .append(std::to_string(meta.full_height));
+    throw std::invalid_argument(message);
+  }
+}
 
 const char* to_string(Parity p) { return p == Parity::Full ? "full" : "reduced"; }
 

@@ -1,47 +1,24 @@
 // The checked-in golden vectors (tests/golden/vectors.txt): every stage file of `trm vectors` for a few small
 // scenes, as 64-bit FNV-1a hashes. Any change of the fixed-point decoder's bits must be deliberate.
+#include "trm_process.hpp"
 #include "vectors.hpp"
 
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <map>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct TrmRun {
-  int exit_code = -1;
-  std::string output;
-};
-
-TrmRun trm(const std::string& args) {
-  TrmRun r;
-  FILE* pipe = popen((std::string(TRM_EXECUTABLE) + " " + args + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buffer{};
-  while (fgets(buffer.data(), static_cast<int>(buffer.size()), pipe)) r.output += buffer.data();
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-fs::path scratch() {
-  std::random_device rd;
-  const fs::path p = fs::temp_directory_path() / ("trm-hw-" + std::to_string(rd()));
-  fs::create_directories(p);
-  return p;
-}
+using TrmRun = trm::test::TrmResult;
+using trm::test::run_trm;
 
 // "<scene> <panel> <file>" -> hash, comment lines skipped.
 std::map<std::string, std::string> parse(const std::string& text) {
@@ -87,8 +64,9 @@ TEST(GoldenVectors, FixedDecoderStagesMatchTheCheckedInHashes) {
 }
 
 TEST(HwReport, WritesJsonWithTotalsAndThePaperComparison) {
-  const fs::path dir = scratch();
-  const TrmRun r = trm("hw-report --size 64x48 --panel lcd --residual-bits 18 --json " + (dir / "hw.json").string() +
+  const trm::test::ScratchDir scratch("trm-hw-");
+  const fs::path& dir = scratch.path();
+  const TrmRun r = run_trm("hw-report --size 64x48 --panel lcd --residual-bits 18 --json " + (dir / "hw.json").string() +
                     " --out " + (dir / "out").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("paper's previous frame + residual"), std::string::npos) << r.output;
@@ -103,26 +81,26 @@ TEST(HwReport, WritesJsonWithTotalsAndThePaperComparison) {
   EXPECT_FALSE(hw["roms"].empty());
   EXPECT_FALSE(hw["arithmetic"].empty());
   EXPECT_TRUE(fs::exists(dir / "out" / "report.json"));
-  fs::remove_all(dir);
 }
 
 TEST(HwReport, BadInputFailsWithoutOutput) {
-  const fs::path dir = scratch();
+  const trm::test::ScratchDir scratch("trm-hw-");
+  const fs::path& dir = scratch.path();
   for (const std::string& args : {std::string("hw-report --residual-bits 2"), std::string("hw-report --residual-bits 40"),
                                   std::string("hw-report --size 0x4"), std::string("vectors --scene nope"),
                                   std::string("vectors --scene discs --size 3"),
                                   std::string("vectors --scene discs --frames 0")}) {
-    const TrmRun r = trm(args + " --out " + (dir / "out").string());
+    const TrmRun r = run_trm(args + " --out " + (dir / "out").string());
     EXPECT_NE(r.exit_code, 0) << args << "\n" << r.output;
     EXPECT_FALSE(r.output.empty()) << args;
     EXPECT_FALSE(fs::exists(dir / "out")) << args;
   }
-  fs::remove_all(dir);
 }
 
 TEST(Vectors, WritesOneHexFilePerStageAndAReadme) {
-  const fs::path dir = scratch();
-  const TrmRun r = trm("vectors --scene checker --frames 2 --size 10x6 --panel lcd --out " + (dir / "v").string());
+  const trm::test::ScratchDir scratch("trm-hw-");
+  const fs::path& dir = scratch.path();
+  const TrmRun r = run_trm("vectors --scene checker --frames 2 --size 10x6 --panel lcd --out " + (dir / "v").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream readme(dir / "v" / "README.md");
   std::stringstream text;
@@ -137,7 +115,6 @@ TEST(Vectors, WritesOneHexFilePerStageAndAReadme) {
   }
   EXPECT_EQ(lines, 6);
   EXPECT_TRUE(fs::exists(dir / "v" / "frame_001_reduced_w.hex"));
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -1,53 +1,29 @@
 // End-to-end checks of the `trm` command line: exit codes, messages, outputs written whole or not at all.
+#include "trm_process.hpp"
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <string>
-#include <sys/wait.h>
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
+using Result = trm::test::TrmResult;
+using trm::test::run_trm;
 
-Result run_trm(const std::string& args) {
-  const std::string command = std::string(TRM_EXECUTABLE) + " " + args + " 2>&1";
-  Result result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buffer{};
-  while (fgets(buffer.data(), static_cast<int>(buffer.size()), pipe)) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-class TempDir {
+// A scratch directory for one test, removed afterwards.
+class TempDir : public trm::test::ScratchDir {
  public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("trm-cli-" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
-  const fs::path& path() const { return path_; }
-  std::string str(const std::string& child) const { return (path_ / child).string(); }
-
- private:
-  fs::path path_;
+  TempDir() : ScratchDir("trm-cli-") {}
 };
 
 // Writes n random 8-bit sRGB frames (RGB noise, deterministic) as frame_000.png ...

@@ -75,6 +75,10 @@ struct DecodedFrame {
   std::optional<DecodeStages> stages;  // when DecoderConfig::record_stages
 };
 
+// What any decoder shows for a view that never arrived (DESIGN §4): `last`, this eye's previous output at the same
+// view size, again; or black when there is none (null). Marked lost, every line counted as concealed.
+DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last);
+
 class ReferenceDecoder {
  public:
   explicit ReferenceDecoder(DecoderConfig config);

@@ -43,6 +43,11 @@ struct FrameMeta {
   Transfer transfer = Transfer::Srgb;
 };
 
+// The metadata every decoder needs of a view, also of a lost one: index >= 0 (the residual adjacency test compares
+// the stored index with index - 1), eye >= 0, and a full size of 1x1 .. kMaxViewSide^2, so that a corrupted header
+// is rejected before taps or frame stores of that size are built. Throws std::invalid_argument starting with `what`.
+void check_view_meta(const FrameMeta& meta, const std::string& what);
+
 // One view of one link frame: encoded, quantised codes (CV_16UC3, RGB).
 struct LinkFrame {
   FrameMeta meta;
