@@ -15,6 +15,18 @@
 namespace trm {
 namespace {
 
+// The largest code k with x >= T_k in an increasing threshold ROM (T_0 = 0, one word per code): the quantiser of a
+// threshold ROM, by binary search (log2 of the ROM size comparisons).
+std::uint16_t threshold_search(const std::vector<std::int64_t>& thresholds, std::int64_t x) {
+  int lo = 0;
+  int hi = static_cast<int>(thresholds.size()) - 1;
+  while (lo < hi) {
+    const int mid = (lo + hi + 1) / 2;
+    if (x >= thresholds[static_cast<std::size_t>(mid)]) lo = mid; else hi = mid - 1;
+  }
+  return static_cast<std::uint16_t>(lo);
+}
+
 [[noreturn]] void reject(const std::string& stage, const std::string& why) {
   throw std::invalid_argument("FixedDecoderConfig: " + stage + ": " + why);
 }
@@ -402,13 +414,7 @@ std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const Poly
 
 std::uint16_t FixedKernels::encode_linear(Raw x) const {
   // Binary search over the threshold ROM: b comparisons per reduced sample.
-  int lo = 0;
-  int hi = max_code();
-  while (lo < hi) {
-    const int mid = (lo + hi + 1) / 2;
-    if (x >= encode_thresholds_[static_cast<std::size_t>(mid)]) lo = mid; else hi = mid - 1;
-  }
-  return static_cast<std::uint16_t>(lo);
+  return threshold_search(encode_thresholds_, x);
 }
 
 Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper,
@@ -603,14 +609,7 @@ std::uint8_t FixedKernels::compare_line(const std::uint16_t* stored, const std::
 
 std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
   // Binary search over the threshold ROM: o comparisons per sample.
-  const std::vector<Raw>& t = thresholds_[static_cast<std::size_t>(ch)];
-  int lo = 0;
-  int hi = max_output_code();
-  while (lo < hi) {
-    const int mid = (lo + hi + 1) / 2;
-    if (linear >= t[static_cast<std::size_t>(mid)]) lo = mid; else hi = mid - 1;
-  }
-  return static_cast<std::uint16_t>(lo);
+  return threshold_search(thresholds_[static_cast<std::size_t>(ch)], linear);
 }
 
 Raw FixedKernels::drive_value(Raw linear, int ch) const {

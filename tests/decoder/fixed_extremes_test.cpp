@@ -44,15 +44,6 @@ struct CaseRun {
 using FrameCheck =
     std::function<void(const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&, const DecodedFrame*)>;
 
-void add_counts(FixedStageCounts& total, const FixedStageCounts& c) {
-  total.beta_clipped += c.beta_clipped;
-  total.residual_saturated += c.residual_saturated;
-  total.residual_rounded += c.residual_rounded;
-  total.alpha_clipped += c.alpha_clipped;
-  total.weight_underflow += c.weight_underflow;
-  total.lcd_unreachable += c.lcd_unreachable;
-}
-
 // Decodes the frames with FixedFrameDecoder and FixedStreamingDecoder (bit-identical, every frame) and, for the
 // first `reference_frames` frames, with the reference (LCD: from the fixed decoder's panel state).
 CaseRun run_case(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config, const std::string& what,
@@ -71,7 +62,7 @@ CaseRun run_case(const std::vector<LinkFrame>& frames, const FixedDecoderConfig&
     const FixedStageCounts& counts = streaming_decoder.last_counts();
     test::expect_identical_outputs(a, frame_decoder.last_counts(), b, counts, where);
     if (::testing::Test::HasFatalFailure()) return run;
-    add_counts(run.totals, counts);
+    run.totals += counts;
     run.max_residual = std::max(run.max_residual, b.stats.residual_max_abs);
     ++run.frames;
     if (n >= reference_frames) {

@@ -130,16 +130,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   if (view.fixed_counts) {
     const FixedStageCounts& c = *view.fixed_counts;
     rec["fixed_point_events"] = events_json(c);
-    fixed_totals_.beta_clipped += c.beta_clipped;
-    fixed_totals_.residual_saturated += c.residual_saturated;
-    fixed_totals_.residual_rounded += c.residual_rounded;
-    fixed_totals_.alpha_clipped += c.alpha_clipped;
-    fixed_totals_.weight_underflow += c.weight_underflow;
-    fixed_totals_.lcd_unreachable += c.lcd_unreachable;
-    fixed_totals_.motion_test_lines_skipped += c.motion_test_lines_skipped;
-    fixed_totals_.residual_read_lines_skipped += c.residual_read_lines_skipped;
-    fixed_totals_.residual_write_lines_skipped += c.residual_write_lines_skipped;
-    fixed_totals_.grey_pixels_skipped += c.grey_pixels_skipped;
+    fixed_totals_ += c;
     if (meta.parity == Parity::Reduced && d.stats.residual_applied) skip_lines_reduced_ += meta.full_height;
     if (meta.parity == Parity::Full) skip_lines_full_ += meta.full_height;
     have_fixed_counts_ = true;

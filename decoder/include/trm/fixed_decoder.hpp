@@ -145,6 +145,21 @@ struct FixedStageCounts {
   // with equal per-channel panel gammas (LCD, or an OLED with one gamma; not the Vive / Rift presets, whose drive
   // ROMs differ per channel) and, on LCD, equal v_{t-1} and x_{t-1} across the pixel's channels.
   std::uint64_t grey_pixels_skipped = 0;
+
+  // Totals over frames.
+  FixedStageCounts& operator+=(const FixedStageCounts& c) {
+    beta_clipped += c.beta_clipped;
+    residual_saturated += c.residual_saturated;
+    residual_rounded += c.residual_rounded;
+    alpha_clipped += c.alpha_clipped;
+    weight_underflow += c.weight_underflow;
+    lcd_unreachable += c.lcd_unreachable;
+    motion_test_lines_skipped += c.motion_test_lines_skipped;
+    residual_read_lines_skipped += c.residual_read_lines_skipped;
+    residual_write_lines_skipped += c.residual_write_lines_skipped;
+    grey_pixels_skipped += c.grey_pixels_skipped;
+    return *this;
+  }
 };
 
 // One line buffer or frame store of the streaming model.
