@@ -162,10 +162,6 @@ void FixedDecoderConfig::validate() const {
                           "codes " + std::to_string(k - 1) + " and " + std::to_string(k) + " collapse");
       }
     }
-    if (1 + linear_frac_bits + 2 * bilinear_weight_frac_bits > 62) {
-      reject("U (linear resample space)", "lin(d) x weights accumulator exceeds 62 bits (1 + linear_frac_bits + 2 "
-                                          "bilinear_weight_frac_bits > 62)");
-    }
   }
   require_range("D (Gaussian taps)", "gaussian_tap_frac_bits", gaussian_tap_frac_bits, 8, 30);
   require_range("D (line buffer)", "gaussian_line_frac_bits", gaussian_line_frac_bits, 0, 30);
@@ -173,9 +169,9 @@ void FixedDecoderConfig::validate() const {
     reject("D (line buffer)", "codes x taps accumulator exceeds 62 bits (bits + line + tap fraction bits)");
   }
   require_range("U (bilinear weights)", "bilinear_weight_frac_bits", bilinear_weight_frac_bits, 4, 24);
-  require_range("U (output)", "upsample_frac_bits", upsample_frac_bits, 0, 24 - link.bits);
-  require_range("U (output)", "upsample_frac_bits", upsample_frac_bits, 0, 2 * bilinear_weight_frac_bits);
-  require_range("EOTF LUT", "eotf_segments_per_code_log2", eotf_segments_per_code_log2, 0, upsample_frac_bits);
+  require_range("U (output)", "upsample_frac_bits", upsample_bits(), 0, 24 - link.bits);
+  require_range("U (output)", "upsample_frac_bits", upsample_bits(), 0, 2 * bilinear_weight_frac_bits);
+  require_range("EOTF LUT", "eotf_segments_per_code_log2", eotf_segments_per_code_log2, 0, upsample_bits());
   if ((static_cast<std::int64_t>((1 << link.bits) - 1) << eotf_segments_per_code_log2) + 1 > 65536) {
     reject("EOTF LUT", "(2^bits - 1) 2^k + 1 entries exceed the 65536-word ROM limit");
   }
@@ -252,13 +248,13 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
   // index and weight plain bit fields of the address. (Encoded space only: in linear space U outputs linear light.)
   fx::LutShape eotf_shape;
   eotf_shape.entries = (max_code() << config_.eotf_segments_per_code_log2) + 1;
-  eotf_shape.input_bits = link.bits + config_.upsample_frac_bits;
+  eotf_shape.input_bits = link.bits + config_.upsample_bits();
   eotf_shape.output_bits = 1 + F;
   eotf_shape.output_frac_bits = F;
   const Transfer transfer = link.transfer;
   if (!linear_space_) {
     eotf_ = std::make_unique<fx::InterpolatedLut>(
-        "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.upsample_frac_bits),
+        "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.upsample_bits()),
         [transfer](double t) { return to_linear(t, transfer); });
   }
 
@@ -421,17 +417,20 @@ Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom
                         Raw row_upper) const {
   const Raw unit = Raw{1} << config_.bilinear_weight_frac_bits;
   if (linear_space_) {
-    // U on linear light: the four codes through the I ROM (uQ1.F), result uQ1.F.
-    const Raw top = (unit - col_upper) * code_rom_[static_cast<std::size_t>(top_left)] +
-                    col_upper * code_rom_[static_cast<std::size_t>(top_right)];
-    const Raw bottom = (unit - col_upper) * code_rom_[static_cast<std::size_t>(bottom_left)] +
-                       col_upper * code_rom_[static_cast<std::size_t>(bottom_right)];
-    return round_shift((unit - row_upper) * top + row_upper * bottom, 2 * config_.bilinear_weight_frac_bits);
+    // U on linear light: the four codes through the I ROM (uQ1.F), result uQ1.F. The exact sum has 1 + F + 2W bits
+    // (77 at the defaults): a 128-bit accumulator.
+    using Wide = fx::detail::int128;
+    const Wide top = (unit - col_upper) * code_rom_[static_cast<std::size_t>(top_left)] +
+                     col_upper * code_rom_[static_cast<std::size_t>(top_right)];
+    const Wide bottom = (unit - col_upper) * code_rom_[static_cast<std::size_t>(bottom_left)] +
+                        col_upper * code_rom_[static_cast<std::size_t>(bottom_right)];
+    const int shift = 2 * config_.bilinear_weight_frac_bits;
+    return static_cast<Raw>(((unit - row_upper) * top + row_upper * bottom + (Wide{1} << (shift - 1))) >> shift);
   }
   const Raw top = (unit - col_upper) * top_left + col_upper * top_right;            // uQb.W
   const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
   const Raw blended = (unit - row_upper) * top + row_upper * bottom;               // uQb.2W
-  return round_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_frac_bits);  // uQb.U
+  return round_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_bits());  // uQb.U
 }
 
 Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col,

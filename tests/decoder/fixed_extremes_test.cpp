@@ -227,9 +227,7 @@ TEST(FixedExtremes, NyquistCheckerboards) {
                         EXPECT_EQ(counts.weight_underflow, 0u);
                       });
         }
-        // Counter-phase: the board inverts every frame, the largest change there is. (At r = 0.4 one pixel position
-        // per period lands 4e-4 code from a drive rounding boundary: CounterPhaseBoardsAtR04StayWithinOneLsb below.)
-        if (grid.r == 0.4) continue;
+        // Counter-phase: the board inverts every frame, the largest change there is.
         expect_case(encode_sequence(generated(6, [&](int t) {
                                       return test::checkerboard(size.width, size.height, cell, t % 2);
                                     }),
@@ -302,12 +300,16 @@ TEST(FixedExtremes, SingleBrightPixelOvershootAndUndershoot) {
       const auto [lowest, highest] = std::minmax_element(beta.values.begin(), beta.values.end());
       EXPECT_GE(static_cast<double>(*highest) / one, 1.8) << what;  // maximal overshoot: beta = 2 - L
       EXPECT_LT(*lowest, 0) << what;                                 // undershoot around the pixel: beta = -L
-      // The default store (sQ2.24) holds every rho exactly.
-      EXPECT_EQ(full.counts.residual_saturated, 0u) << what;
-      EXPECT_EQ(full.counts.residual_rounded, 0u) << what;
+      // The default store (sQ2.24) holds every rho in range (rho in [-1, 1]), rounded to its 24 fraction bits.
+      std::uint64_t rounded = 0;
       for (std::size_t k = 0; k < rho.values.size(); ++k) {
-        ASSERT_EQ(rho.values[k], beta.values[k] - shown.values[k]) << what << " sample " << k;
+        const StoredRho stored = store_rho(beta.values[k] - shown.values[k], config.linear_frac_bits, config.residual);
+        ASSERT_FALSE(stored.saturated) << what << " sample " << k;
+        ASSERT_EQ(rho.values[k], stored.value) << what << " sample " << k;
+        rounded += stored.rounded ? 1 : 0;
       }
+      EXPECT_EQ(full.counts.residual_saturated, 0u) << what;
+      EXPECT_EQ(full.counts.residual_rounded, rounded) << what;
       const CaseRun run = expect_case(frames, config, what,
                                       [&](const LinkFrame& frame, const DecodedFrame& fixed, const FixedStageCounts&,
                                           const DecodedFrame* reference) {
@@ -1079,18 +1081,34 @@ TEST(FixedExtremes, FrameIndexAtTheEndOfItsRange) {
 // from a rounding boundary. A periodic 24x16 pattern repeats that one knife-edge value 24 times: 24 of 6912 codes
 // (0.35 %) differ, by 1 LSB. (A finer EOTF LUT, 16 segments per code, does not move it.) What holds is asserted:
 // every code within 1 LSB, and the share identical at its measured value.
-TEST(FixedExtremes, CounterPhaseBoardsAtR04StayWithinOneLsb) {
-  for (int cell : {1, 3}) {
-    const EncoderConfig link = link_config(0.4);
-    const std::string what = "24x16 counter-phase cell " + std::to_string(cell) + " r=0.4";
-    const CaseRun run = run_case(
-        encode_sequence(generated(6, [&](int t) { return test::checkerboard(24, 16, cell, t % 2); }), link),
-        fixed_config(link), what);
-    std::printf("[ fixed vs reference ] %-40s identical %8.4f %%  max %d LSB\n", what.c_str(),
-                100.0 * run.agreement.identical_fraction(), run.agreement.max_lsb);
-    EXPECT_LE(run.agreement.max_lsb, 1) << what;
-    EXPECT_GE(run.agreement.identical_fraction(), 0.996) << what;
+// Counter-phase checkerboards across reductions, cell sizes, sizes and contrasts. The motion test amplifies the
+// error of L_{t-1} and alpha (FixedDecoderConfig::linear_frac_bits), and a periodic pattern repeats a pixel that
+// lands near a drive rounding boundary in every period: at the former defaults 7 of these sequences fell below
+// 99.9 % identical (24x16, cell 1, r = 0.4: 99.65 %, one position per period 4e-4 code from a boundary).
+TEST(FixedExtremes, CounterPhaseBoardsAcrossReductions) {
+  std::int64_t differing = 0;
+  for (double r : {0.25, 0.4, 0.5, 0.6, 0.75}) {
+    const EncoderConfig link = link_config(r);
+    for (int cell : {1, 2, 3, 4, 5}) {
+      for (const cv::Size size : {cv::Size(24, 16), cv::Size(31, 19), cv::Size(40, 30)}) {
+        for (double low : {0.0, 0.2}) {  // black/white, and 0.2/0.8
+          const std::string what = "counter-phase cell " + std::to_string(cell) + " " + size_name(size) + " " +
+                                   r_name(r) + (low > 0.0 ? " reduced contrast" : "");
+          const CaseRun run = expect_case(encode_sequence(generated(6, [&](int t) {
+                                                            cv::Mat board = test::checkerboard(size.width, size.height,
+                                                                                               cell, t % 2);
+                                                            board.convertTo(board, -1, 1.0 - 2.0 * low, low);
+                                                            return board;
+                                                          }),
+                                                          link),
+                                          fixed_config(link), what);
+          differing += static_cast<std::int64_t>(run.agreement.samples - run.agreement.identical);
+        }
+      }
+    }
   }
+  std::printf("[ fixed vs reference ] 150 counter-phase boards: %lld differing codes\n",
+              static_cast<long long>(differing));
 }
 
 // Degenerate Gaussian sigma. sigma = 0.01 at r = 1/2: every absolute weight at the half-integer centres underflows

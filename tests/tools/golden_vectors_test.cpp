@@ -105,13 +105,13 @@ TEST(Vectors, WritesOneHexFilePerStageAndAReadme) {
   std::ifstream readme(dir / "v" / "README.md");
   std::stringstream text;
   text << readme.rdbuf();
-  EXPECT_NE(text.str().find("sQ3.24"), std::string::npos);  // beta, from the configuration
+  EXPECT_NE(text.str().find("sQ3.28"), std::string::npos);  // beta, from the configuration
   std::ifstream beta(dir / "v" / "frame_000_full_beta.hex");
   std::string line;
   int lines = 0;
   while (std::getline(beta, line)) {
     ++lines;
-    EXPECT_EQ(line.size(), 10u * 3u * 8u - 1u);  // 30 words of 7 hex digits, one space between
+    EXPECT_EQ(line.size(), 10u * 3u * 9u - 1u);  // 30 words of 8 hex digits (31 bits), one space between
   }
   EXPECT_EQ(lines, 6);
   EXPECT_TRUE(fs::exists(dir / "v" / "frame_001_reduced_w.hex"));

@@ -141,8 +141,11 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
 }
 
 TEST(Sweep, BasePointAgreesWithADirectComparison) {
+  // A narrow residual store as the base, so that the comparison is not all-identical (at the default formats every
+  // code of this sequence is).
   trm::cli::SweepOptions o = small_sweep("residual_bits", 48, 40, 4);
-  o.values = {26};
+  o.pipeline.residual_bits = 12;
+  o.values = {12};
   const trm::cli::SweepResult result = trm::cli::run_sweep(o);
 
   // `trm run`'s way: the streaming decoder with the reference beside it, codes compared view by view.
@@ -165,7 +168,7 @@ TEST(Sweep, BasePointAgreesWithADirectComparison) {
   EXPECT_TRUE(base.is_default);
   EXPECT_EQ(base.codes, codes);
   EXPECT_EQ(base.differing, differing);
-  EXPECT_GT(differing, 0);  // the comparison is not trivially all-identical at this size
+  EXPECT_GT(differing, 0);  // the comparison is not trivially all-identical
   EXPECT_EQ(base.max_lsb, max_lsb);
   EXPECT_DOUBLE_EQ(base.identical_percent, 100.0 * static_cast<double>(codes - differing) / static_cast<double>(codes));
   EXPECT_EQ(result.views, 4);
@@ -190,20 +193,20 @@ TEST(Sweep, ResidualErrorFallsAsTheStoreWidens) {
 
 TEST(Sweep, RejectedValuesAreReportedNotFatal) {
   ScratchDir tmp("trm-sweep-");
-  // U's output keeps 14 fraction bits: weights narrower than 7 bits cannot feed it.
+  // U's output keeps 16 fraction bits (8-bit link): weights narrower than 8 bits cannot feed it.
   const auto r = run_trm("sweep --quick --size 16x12 --knob bilinear_weight_frac_bits --values 4,6,8 -o " +
                          tmp.str("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::vector<std::string> header;
   const auto rows = read_csv(tmp.path() / "out" / "sweep.csv", &header);
-  ASSERT_EQ(rows.size(), 4u);  // 4, 6, 8 and the base 16
+  ASSERT_EQ(rows.size(), 4u);  // 4, 6, 8 and the base 24
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(rows[i].at("status"), "rejected");
     EXPECT_NE(rows[i].at("message").find("upsample_frac_bits"), std::string::npos) << rows[i].at("message");
     EXPECT_EQ(rows[i].at("meets_criterion"), "0");
   }
   EXPECT_EQ(rows[2].at("status"), "ok");
-  EXPECT_EQ(rows[3].at("value"), "16");
+  EXPECT_EQ(rows[3].at("value"), "24");
   EXPECT_EQ(rows[3].at("is_default"), "1");
   EXPECT_TRUE(fs::exists(tmp.path() / "out" / "sweep_bilinear_weight_frac_bits.png"));
 
