@@ -169,9 +169,8 @@ void FixedDecoderConfig::validate() const {
     reject("D (line buffer)", "codes x taps accumulator exceeds 62 bits (bits + line + tap fraction bits)");
   }
   require_range("U (bilinear weights)", "bilinear_weight_frac_bits", bilinear_weight_frac_bits, 4, 24);
-  require_range("U (output)", "upsample_frac_bits", upsample_bits(), 0, 24 - link.bits);
-  require_range("U (output)", "upsample_frac_bits", upsample_bits(), 0, 2 * bilinear_weight_frac_bits);
-  require_range("EOTF LUT", "eotf_segments_per_code_log2", eotf_segments_per_code_log2, 0, upsample_bits());
+  require_range("EOTF LUT", "eotf_segments_per_code_log2", eotf_segments_per_code_log2, 0, 12);
+  require_range("U (output)", "upsample_frac_bits", upsample_frac_bits, eotf_segments_per_code_log2, 32);
   if ((static_cast<std::int64_t>((1 << link.bits) - 1) << eotf_segments_per_code_log2) + 1 > 65536) {
     reject("EOTF LUT", "(2^bits - 1) 2^k + 1 entries exceed the 65536-word ROM limit");
   }
@@ -248,13 +247,13 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
   // index and weight plain bit fields of the address. (Encoded space only: in linear space U outputs linear light.)
   fx::LutShape eotf_shape;
   eotf_shape.entries = (max_code() << config_.eotf_segments_per_code_log2) + 1;
-  eotf_shape.input_bits = link.bits + config_.upsample_bits();
+  eotf_shape.input_bits = link.bits + config_.eotf_segments_per_code_log2;  // the ROM address (node index)
   eotf_shape.output_bits = 1 + F;
   eotf_shape.output_frac_bits = F;
   const Transfer transfer = link.transfer;
   if (!linear_space_) {
     eotf_ = std::make_unique<fx::InterpolatedLut>(
-        "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.upsample_bits()),
+        "eotf", eotf_shape, std::ldexp(static_cast<double>(max_code()), config_.eotf_segments_per_code_log2),
         [transfer](double t) { return to_linear(t, transfer); });
   }
 
@@ -430,7 +429,7 @@ Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom
   const Raw top = (unit - col_upper) * top_left + col_upper * top_right;            // uQb.W
   const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
   const Raw blended = (unit - row_upper) * top + row_upper * bottom;               // uQb.2W
-  return round_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_bits());  // uQb.U
+  return round_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_frac_bits);  // uQb.U
 }
 
 Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col,
@@ -441,7 +440,14 @@ Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1,
 
 Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
   if (linear_space_) return upsampled;
-  return eotf_->evaluate_raw(static_cast<std::uint32_t>(upsampled));
+  // The top bits of U's output address the ROM node, the rest weigh the step to the next node (wider than any
+  // address the ROM has: the same arithmetic as fx::InterpolatedLut, whose inputs stop at 24 bits).
+  const int weight_bits = config_.upsample_frac_bits - config_.eotf_segments_per_code_log2;
+  const std::vector<std::int64_t>& rom = eotf_->rom();
+  const std::size_t node = static_cast<std::size_t>(upsampled >> weight_bits);
+  if (node + 1 >= rom.size()) return rom.back();
+  const Raw weight = upsampled & ((Raw{1} << weight_bits) - 1);
+  return rom[node] + round_shift((rom[node + 1] - rom[node]) * weight, weight_bits);
 }
 
 CompensatedSample FixedKernels::split(Raw beta) const {

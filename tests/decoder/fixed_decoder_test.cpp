@@ -261,7 +261,7 @@ TEST(FixedDecoder, RejectsBadConfiguration) {
   c.residual.frac_bits = 16;
   expect_rejected(c, "drive (linear light)");
   c = good;
-  c.upsample_frac_bits = 20;  // 8 + 20 address bits > 24
+  c.upsample_frac_bits = 33;  // above the 32-bit interpolation weight path
   expect_rejected(c, "U (output)");
   c = good;
   c.eotf_segments_per_code_log2 = 9;

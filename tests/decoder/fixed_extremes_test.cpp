@@ -300,7 +300,7 @@ TEST(FixedExtremes, SingleBrightPixelOvershootAndUndershoot) {
       const auto [lowest, highest] = std::minmax_element(beta.values.begin(), beta.values.end());
       EXPECT_GE(static_cast<double>(*highest) / one, 1.8) << what;  // maximal overshoot: beta = 2 - L
       EXPECT_LT(*lowest, 0) << what;                                 // undershoot around the pixel: beta = -L
-      // The default store (sQ2.24) holds every rho in range (rho in [-1, 1]), rounded to its 24 fraction bits.
+      // The default store (sQ2.F) holds every rho (in [-1, 1]) exactly.
       std::uint64_t rounded = 0;
       for (std::size_t k = 0; k < rho.values.size(); ++k) {
         const StoredRho stored = store_rho(beta.values[k] - shown.values[k], config.linear_frac_bits, config.residual);
@@ -310,6 +310,7 @@ TEST(FixedExtremes, SingleBrightPixelOvershootAndUndershoot) {
       }
       EXPECT_EQ(full.counts.residual_saturated, 0u) << what;
       EXPECT_EQ(full.counts.residual_rounded, rounded) << what;
+      EXPECT_EQ(rounded, 0u) << what;
       const CaseRun run = expect_case(frames, config, what,
                                       [&](const LinkFrame& frame, const DecodedFrame& fixed, const FixedStageCounts&,
                                           const DecodedFrame* reference) {
@@ -1086,29 +1087,34 @@ TEST(FixedExtremes, FrameIndexAtTheEndOfItsRange) {
 // lands near a drive rounding boundary in every period: at the former defaults 7 of these sequences fell below
 // 99.9 % identical (24x16, cell 1, r = 0.4: 99.65 %, one position per period 4e-4 code from a boundary).
 TEST(FixedExtremes, CounterPhaseBoardsAcrossReductions) {
-  std::int64_t differing = 0;
-  for (double r : {0.25, 0.4, 0.5, 0.6, 0.75}) {
-    const EncoderConfig link = link_config(r);
-    for (int cell : {1, 2, 3, 4, 5}) {
-      for (const cv::Size size : {cv::Size(24, 16), cv::Size(31, 19), cv::Size(40, 30)}) {
-        for (double low : {0.0, 0.2}) {  // black/white, and 0.2/0.8
-          const std::string what = "counter-phase cell " + std::to_string(cell) + " " + size_name(size) + " " +
-                                   r_name(r) + (low > 0.0 ? " reduced contrast" : "");
-          const CaseRun run = expect_case(encode_sequence(generated(6, [&](int t) {
-                                                            cv::Mat board = test::checkerboard(size.width, size.height,
-                                                                                               cell, t % 2);
-                                                            board.convertTo(board, -1, 1.0 - 2.0 * low, low);
-                                                            return board;
-                                                          }),
-                                                          link),
-                                          fixed_config(link), what);
-          differing += static_cast<std::int64_t>(run.agreement.samples - run.agreement.identical);
+  for (const char* panel : {"vive", "rift"}) {
+    for (int output_bits : {8, 10}) {
+      std::int64_t differing = 0;
+      for (double r : {0.25, 0.4, 0.5, 0.6, 0.75}) {
+        const EncoderConfig link = link_config(r);
+        for (int cell : {1, 2, 3, 4, 5}) {
+          for (const cv::Size size : {cv::Size(24, 16), cv::Size(31, 19), cv::Size(40, 30)}) {
+            for (double low : {0.0, 0.1}) {  // black/white, and 0.1/0.9
+              const std::string what = std::string(panel) + " " + std::to_string(output_bits) + "-bit counter-phase cell " +
+                                       std::to_string(cell) + " " + size_name(size) + " " + r_name(r) +
+                                       (low > 0.0 ? " reduced contrast" : "");
+              const std::vector<LinkFrame> frames = encode_sequence(generated(6, [&](int t) {
+                                                                      cv::Mat board = test::checkerboard(
+                                                                          size.width, size.height, cell, t % 2);
+                                                                      board.convertTo(board, -1, 1.0 - 2.0 * low, low);
+                                                                      return board;
+                                                                    }),
+                                                                    link);
+              const CaseRun run = expect_case(frames, fixed_config(link, panel, output_bits), what);
+              differing += static_cast<std::int64_t>(run.agreement.samples - run.agreement.identical);
+            }
+          }
         }
       }
+      std::printf("[ fixed vs reference ] %s %d-bit, 150 counter-phase boards: %lld differing codes\n", panel,
+                  output_bits, static_cast<long long>(differing));
     }
   }
-  std::printf("[ fixed vs reference ] 150 counter-phase boards: %lld differing codes\n",
-              static_cast<long long>(differing));
 }
 
 // Degenerate Gaussian sigma. sigma = 0.01 at r = 1/2: every absolute weight at the half-integer centres underflows

@@ -62,9 +62,7 @@ void check_sequence(const std::string& panel) {
           ASSERT_EQ(shown[i], std::clamp<std::int64_t>(beta[i], 0, std::int64_t{1} << F));
           ASSERT_EQ(shown[i], wanted);
           if (panel != "lcd") {
-            // The default store sQ2.24 rounds rho (uQ.F) half up to its 24 fraction bits.
-            const int drop = F - config.residual.frac_bits;
-            ASSERT_EQ(rho[i], (beta[i] - shown[i] + (std::int64_t{1} << (drop - 1))) >> drop);
+            ASSERT_EQ(rho[i], beta[i] - shown[i]);  // the default store sQ2.F holds rho exactly
           }
         } else {
           ASSERT_EQ(taps[FixedStage::AlphaPrime].values[i], wanted);
@@ -121,8 +119,8 @@ TEST(FixedHardwareReport, RomsArithmeticAndFrameStores) {
     // Paper: full previous frame (8 bits) + residual; here: reduced d_t (8-bit link codes) + residual.
     const std::int64_t full = 3LL * 1080 * 1200;
     const std::int64_t reduced = 3LL * 540 * 600;
-    EXPECT_EQ(r.paper_frame_store_bits, full * 8 + full * 26);
-    EXPECT_EQ(r.model_frame_store_bits, reduced * 8 + full * 26);
+    EXPECT_EQ(r.paper_frame_store_bits, full * 8 + full * 30);  // residual sQ2.28
+    EXPECT_EQ(r.model_frame_store_bits, reduced * 8 + full * 30);
   }
 }
 

@@ -130,7 +130,7 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
   }
   std::ifstream md(out / "sweep.md");
   const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("| **26** (base) |"), std::string::npos);  // residual_bits, the base value marked
+  EXPECT_NE(text.find("| **30** (base) |"), std::string::npos);  // residual_bits, the base value marked
   EXPECT_NE(text.find("trm sweep"), std::string::npos);
   std::ifstream js(out / "report.json");
   const auto report = nlohmann::json::parse(js);
@@ -193,22 +193,21 @@ TEST(Sweep, ResidualErrorFallsAsTheStoreWidens) {
 
 TEST(Sweep, RejectedValuesAreReportedNotFatal) {
   ScratchDir tmp("trm-sweep-");
-  // U's output keeps 16 fraction bits (8-bit link): weights narrower than 8 bits cannot feed it.
-  const auto r = run_trm("sweep --quick --size 16x12 --knob bilinear_weight_frac_bits --values 4,6,8 -o " +
-                         tmp.str("out"));
+  // uQ1.16 linear light cannot tell drive codes 0, 1 and 2 apart (rejected by the configuration check).
+  const auto r = run_trm("sweep --quick --size 16x12 --knob linear_frac_bits --values 14,16,20 -o " + tmp.str("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::vector<std::string> header;
   const auto rows = read_csv(tmp.path() / "out" / "sweep.csv", &header);
-  ASSERT_EQ(rows.size(), 4u);  // 4, 6, 8 and the base 24
+  ASSERT_EQ(rows.size(), 4u);  // 14, 16, 20 and the base 28
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(rows[i].at("status"), "rejected");
-    EXPECT_NE(rows[i].at("message").find("upsample_frac_bits"), std::string::npos) << rows[i].at("message");
+    EXPECT_NE(rows[i].at("message").find("drive (linear light)"), std::string::npos) << rows[i].at("message");
     EXPECT_EQ(rows[i].at("meets_criterion"), "0");
   }
   EXPECT_EQ(rows[2].at("status"), "ok");
-  EXPECT_EQ(rows[3].at("value"), "24");
+  EXPECT_EQ(rows[3].at("value"), "28");
   EXPECT_EQ(rows[3].at("is_default"), "1");
-  EXPECT_TRUE(fs::exists(tmp.path() / "out" / "sweep_bilinear_weight_frac_bits.png"));
+  EXPECT_TRUE(fs::exists(tmp.path() / "out" / "sweep_linear_frac_bits.png"));
 
   // A value the knob itself refuses (the residual store needs a sign and an integer bit).
   const auto narrow = trm::cli::run_sweep([] {

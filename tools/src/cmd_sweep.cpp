@@ -65,7 +65,7 @@ void register_sweep(CLI::App& app, Action& action) {
   cmd->remove_option(cmd->get_option("--impl"));
   cmd->get_option("--size")->description("View size WxH decoded at each point (default 270x300)");
   cmd->get_option("--residual-bits")
-      ->description("Residual store width N of the base configuration, sQ2.(N-2) (default: 26, lossless)");
+      ->description("Residual store width N of the base configuration, sQ2.(N-2) (default: 30, lossless)");
   cmd->add_option("--knob", options->knobs, "Knob to sweep (repeatable; default: every knob the panel uses)");
   cmd->add_option("--values", options->values, "Values of the one --knob, comma separated (the base value is added)")
       ->delimiter(',');

@@ -116,7 +116,7 @@ void PipelineOptions::add_options(CLI::App& cmd) {
       "previous frame actually contributed (contributed)");
   cmd.add_option("--seed", seed, "Seed for scenes with randomness")->capture_default_str();
   cmd.add_option("--residual-bits", residual_bits,
-                 "Fixed-point residual store width N, signed sQ2.(N-2) (default: 26, lossless)");
+                 "Fixed-point residual store width N, signed sQ2.(N-2) (default: 30, lossless)");
   cmd.add_flag("--no-skip", no_skip,
                "Fixed-point decoders: do not skip the work a scene does not need (static lines' motion test, "
                "all-zero residual lines); the output is bit-identical either way");

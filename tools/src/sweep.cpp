@@ -61,11 +61,9 @@ std::vector<SweepKnob> make_knobs() {
                              &FixedDecoderConfig::gaussian_line_frac_bits));
   knobs.push_back(field_knob("bilinear_weight_frac_bits", "U (bilinear) weights uQ0.W", "arithmetic width only",
                              {4, 6, 8, 10, 12, 14, 16, 20, 24}, &FixedDecoderConfig::bilinear_weight_frac_bits));
-  SweepKnob upsample = field_knob("upsample_frac_bits", "U output in codes uQb.U (the EOTF LUT address)",
-                                  "arithmetic width only", {2, 4, 6, 8, 10, 12, 14, 16},
-                                  &FixedDecoderConfig::upsample_frac_bits);
-  upsample.get = [](const FixedDecoderConfig& c) { return c.upsample_bits(); };  // the default resolved
-  knobs.push_back(std::move(upsample));
+  knobs.push_back(field_knob("upsample_frac_bits", "U output in codes uQb.U (EOTF ROM address + interpolation weight)",
+                             "arithmetic width only", {4, 8, 12, 14, 16, 20, 24, 28, 32},
+                             &FixedDecoderConfig::upsample_frac_bits));
   knobs.push_back(field_knob("eotf_segments_per_code_log2",
                              "EOTF LUT after U: 2^k segments per code step, (2^b - 1) 2^k + 1 words", "ROM (EOTF)",
                              {0, 1, 2, 3, 4, 5, 6, 7, 8}, &FixedDecoderConfig::eotf_segments_per_code_log2));
@@ -73,7 +71,7 @@ std::vector<SweepKnob> make_knobs() {
   residual.name = "residual_bits";
   residual.description = "residual store rho: N bits, sQ2.(N - 2) (as --residual-bits)";
   residual.cost = "frame store (residual)";
-  residual.values = {4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26};
+  residual.values = {4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30};
   residual.get = [](const FixedDecoderConfig& c) { return c.residual.width(); };
   residual.set = [](FixedDecoderConfig& c, int v) { c.residual = residual_format_of_bits(v, c.linear_frac_bits); };
   knobs.push_back(std::move(residual));

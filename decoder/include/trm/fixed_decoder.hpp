@@ -33,18 +33,17 @@ struct FixedDecoderConfig {
   // FixedFrameDecoder::decode(frame, taps) records the integer stages instead).
   DecoderConfig decoder;
 
-  // Why the defaults below are wider than natural content needs (docs/sweeps.md: F = 18..21, U weights 8 bits, 4 EOTF
-  // segments per code meet >= 99.9 % identical there): the motion test amplifies the error of L_{t-1} and alpha.
-  // alpha' = alpha + w rho with w = exp(-s c), c = |Yp - Ya| / (Yp + Ya), so an error e in Yp moves alpha' by about
-  // s w |rho| e / (Yp + Ya), and the drive code by that times the panel's slope (x^(1/gamma) (2^o - 1) is steep in
-  // the dark): 8,000 drive codes per unit of e for a counter-phase checkerboard at r = 0.4 (rho = -0.21, Yp + Ya =
-  // 0.43, alpha' = 0.009). A periodic pattern repeats any pixel that lands near a drive rounding boundary in every
-  // period, so its share of differing codes is set by the worst pixel, not the average. Over 150 checkerboard
-  // sequences (r 0.25..0.75, cells 1..5, three sizes, full and reduced contrast), the former defaults (F = 24, U
-  // weights 16 bits, U output 14 bits, 8 EOTF segments per code, exp address 20 bits) left 7 below 99.9 % identical
-  // (worst 99.65 %); the ones below leave none (every code identical), and on the built-in scenes and noise at r =
-  // 0.4 and 0.5, 9 in 2,976,768 codes differ (formerly 115). The cost is in `trm hw-report`: ROM words 4 bits
-  // wider, an EOTF ROM of twice the words, the LCD x_{t-1} store 4 bits wider, wider multipliers.
+  // Why the defaults below are wider than natural content needs (docs/sweeps.md: F = 18..21, U weights 8 bits, an
+  // 18-bit residual store meet >= 99.9 % identical on discs): the motion test amplifies the error of L_{t-1} and
+  // alpha. alpha' = alpha + w rho with w = exp(-s c), c = |Yp - Ya| / (Yp + Ya), so an error e in Yp moves alpha' by
+  // about s w |rho| e / (Yp + Ya), and the drive code by that times the panel's slope (x^(1/gamma) (2^o - 1) is
+  // steep in the dark): 8,000 drive codes per unit of e for a counter-phase checkerboard at r = 0.4. A periodic
+  // pattern repeats any pixel that lands near a drive rounding boundary in every period, so its share of differing
+  // codes is set by the worst pixel, not the average. Over 150 checkerboard sequences inverting every frame
+  // (FixedExtremes.CounterPhaseBoardsAcrossReductions) the former defaults (F = 24, U weights 16 bits, U output 14
+  // bits, 8 EOTF segments per code, exp address 20 bits, rho sQ2.24) left 7 below 99.9 % identical (worst 99.65 %;
+  // 14 at 10-bit output); the ones below leave none, with vive and rift panels, 8- and 10-bit output. The cost is
+  // in `trm hw-report` and the README ("Why the defaults are wider").
   //
   // Linear light I, L, alpha, shown beta, alpha': uQ1.F (the integer bit holds 1.0 exactly). beta = 2I - L is
   // sQ3.F. F = 24 resolves the darkest OLED drive thresholds ((0.5/255)^2.29 = 6.5e-7 = 11 LSB); F = 16 cannot
@@ -86,24 +85,23 @@ struct FixedDecoderConfig {
   // (rounded half up; no EOTF LUT). The weights of r = 0.4, 0.6, ... are not dyadic: their rounding times a step of
   // 255 codes between neighbours is U's largest error on sharp content (2^-17 x 255 = 0.002 code at 16 bits).
   int bilinear_weight_frac_bits = 24;
-  // U output in code units, uQb.F, rounded (Rnd): the address of the EOTF LUT (b + F <= 24 bits). Encoded space only.
-  // kUpsampleFullAddress (the default) gives U every address bit the LUT has: F = 24 - b (16 at 8 bits, 14 at 10).
-  // (The motion test amplifies U's rounding: see linear_frac_bits.)
-  static constexpr int kUpsampleFullAddress = -1;
-  int upsample_frac_bits = kUpsampleFullAddress;
-  // The U output fraction bits in effect (kUpsampleFullAddress resolved against the link's bit depth).
-  int upsample_bits() const { return upsample_frac_bits == kUpsampleFullAddress ? 24 - decoder.link.bits
-                                                                                 : upsample_frac_bits; }
+  // U output in code units, uQb.U, rounded (Rnd). Encoded space only. Its top b + k bits address the EOTF ROM (k =
+  // eotf_segments_per_code_log2) and the other U - k bits are the interpolation weight, so U is not bound by the
+  // ROM's address width: U in [k, 32] (above 2 bilinear_weight_frac_bits the exact blend is only padded). (The motion test amplifies U's rounding:
+  // see linear_frac_bits. At U = 16 the rounding alone moves a bright alpha by up to 5e-8.)
+  int upsample_frac_bits = 32;
   // EOTF LUT after U (encoded space only): uniform segments aligned to link codes, 2^k segments per code step:
-  // (2^b - 1) 2^k + 1 ROM words of uQ1.linear_frac_bits (4081 words at 8 bits). Interpolation error ~h^2/8 |f''|
+  // (2^b - 1) 2^k + 1 ROM words of uQ1.linear_frac_bits (4081 words at 8 bits), y = rom[i] + round((rom[i+1] -
+  // rom[i]) w) with w the low U - k bits of U's output. Interpolation error ~h^2/8 |f''|
   // (h = 1/(2^k (2^b - 1))): 4 segments per code leave ~2e-7 (0.09 % of drive codes differed on the line scene at
   // F = 24), 16 leave ~1.4e-8.
   int eotf_segments_per_code_log2 = 4;
 
-  // The residual frame store rho: signed, saturating, default sQ2.24 (rho in [-1, 1] rounded to 2^-24 = 6e-8: w rho
-  // is added to alpha, not amplified, so the store does not need F's 28 bits; 4 more bits would cost 15.6 Mbit per
-  // eye at 1080x1200).
-  fx::RuntimeFormat residual{2, 24, true, fx::Quant::Rnd, fx::Overflow::Sat};
+  // The residual frame store rho: signed, saturating, default sQ2.28 (lossless for rho in [-1, 1] at F = 28). A
+  // narrower store rounds rho, and alpha' = alpha + rho no longer cancels exactly where alpha = L_{t-1} and I = 0:
+  // sQ2.24 left 2.6e-8 there, above the first 10-bit drive threshold (14 of 150 counter-phase boards below 99.9 %
+  // at 10-bit output). `--residual-bits N` / docs/sweeps.md: what a narrower store costs on natural content.
+  fx::RuntimeFormat residual{2, 28, true, fx::Quant::Rnd, fx::Overflow::Sat};
 
   // Eq. 5 motion contrast: Rec. 709 luma weights uQ0.F summing exactly to 2^F; 1/(Y_prev + Y_alpha) through a
   // normalised reciprocal LUT (mantissa in [1, 2), 24 address bits, `reciprocal_entries` ROM words, uQ2.24).
