@@ -440,14 +440,11 @@ Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1,
 
 Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
   if (linear_space_) return upsampled;
-  // The top bits of U's output address the ROM node, the rest weigh the step to the next node (wider than any
-  // address the ROM has: the same arithmetic as fx::InterpolatedLut, whose inputs stop at 24 bits).
+  // The top bits of U's output address the ROM node, the rest weigh the step to the next node (wider than the
+  // table's own input code, which stops at 24 bits).
   const int weight_bits = config_.upsample_frac_bits - config_.eotf_segments_per_code_log2;
-  const std::vector<std::int64_t>& rom = eotf_->rom();
-  const std::size_t node = static_cast<std::size_t>(upsampled >> weight_bits);
-  if (node + 1 >= rom.size()) return rom.back();
-  const Raw weight = upsampled & ((Raw{1} << weight_bits) - 1);
-  return rom[node] + round_shift((rom[node + 1] - rom[node]) * weight, weight_bits);
+  return eotf_->interpolate(static_cast<std::size_t>(upsampled >> weight_bits),
+                            static_cast<std::uint64_t>(upsampled & ((Raw{1} << weight_bits) - 1)), weight_bits);
 }
 
 CompensatedSample FixedKernels::split(Raw beta) const {

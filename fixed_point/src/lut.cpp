@@ -119,7 +119,6 @@ std::int64_t InterpolatedLut::evaluate_raw(std::uint32_t code) const {
   const std::uint32_t top_code = (std::uint32_t{1} << shape_.input_bits) - 1u;
   code = std::min(code, top_code);
   if (direct_) return rom_[code];
-  const detail::Target out{shape_.output_bits, 0, shape_.output_signed, shape_.rounding, Overflow::Sat};
 
   if (shape_.octaves > 0) {
     // Region by leading one: bottom region [0, 2^b) or octave [2^L, 2^(L+1)), each 2^scale codes.
@@ -131,25 +130,24 @@ std::int64_t InterpolatedLut::evaluate_raw(std::uint32_t code) const {
     const std::uint64_t scaled = offset << segments_per_octave_log2_;  // offset·S
     const std::size_t index = (static_cast<std::size_t>(region) << segments_per_octave_log2_) +
                               static_cast<std::size_t>(scaled >> scale_bits);
-    const auto weight = static_cast<std::int64_t>(scaled & ((std::uint64_t{1} << scale_bits) - 1u));
-    const std::int64_t y0 = rom_[index];
-    const std::int64_t y1 = rom_[index + 1];
-    const detail::int128 exact = detail::shift_left(y0, scale_bits) + static_cast<detail::int128>(y1 - y0) * weight;
-    return static_cast<std::int64_t>(detail::convert(exact, scale_bits, out, nullptr));
+    return interpolate(index, scaled & ((std::uint64_t{1} << scale_bits) - 1u), scale_bits);
   }
 
   const detail::uint128 position = static_cast<detail::uint128>(code) * segment_step_;
-  const auto index = static_cast<std::uint64_t>(position >> kSegmentFracBits);
-  const auto last = static_cast<std::uint64_t>(rom_.size() - 1);
-  if (index >= last) return rom_[last];
-  const auto weight = static_cast<std::int64_t>(static_cast<std::uint64_t>(position) & 0xffffffffu);
+  return interpolate(static_cast<std::size_t>(position >> kSegmentFracBits),
+                     static_cast<std::uint64_t>(position) & 0xffffffffu, kSegmentFracBits);
+}
 
-  // y = rom[i] + (rom[i+1] − rom[i])·w, exact in units of 2^-32 output LSB, then rounded once.
-  const std::int64_t y0 = rom_[index];
-  const std::int64_t y1 = rom_[index + 1];
+std::int64_t InterpolatedLut::interpolate(std::size_t node, std::uint64_t weight, int weight_bits) const {
+  const std::size_t last = rom_.size() - 1;
+  if (node >= last) return rom_[last];
+  // y = rom[i] + (rom[i+1] − rom[i])·w, exact in units of 2^-weight_bits output LSB, then rounded once.
+  const detail::Target out{shape_.output_bits, 0, shape_.output_signed, shape_.rounding, Overflow::Sat};
+  const std::int64_t y0 = rom_[node];
+  const std::int64_t y1 = rom_[node + 1];
   const detail::int128 exact =
-      detail::shift_left(y0, kSegmentFracBits) + static_cast<detail::int128>(y1 - y0) * weight;
-  return static_cast<std::int64_t>(detail::convert(exact, kSegmentFracBits, out, nullptr));
+      detail::shift_left(y0, weight_bits) + static_cast<detail::int128>(y1 - y0) * static_cast<std::int64_t>(weight);
+  return static_cast<std::int64_t>(detail::convert(exact, weight_bits, out, nullptr));
 }
 
 double InterpolatedLut::evaluate(std::uint32_t code) const {

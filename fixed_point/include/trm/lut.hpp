@@ -72,6 +72,11 @@ class InterpolatedLut {
   // Output as a double (raw · 2^-output_frac_bits), for reports and tests.
   double evaluate(std::uint32_t code) const;
 
+  // The interpolation step of evaluate_raw on its own: rom[node] + (rom[node+1] − rom[node])·weight/2^weight_bits,
+  // rounded once into the output format (nodes past the last return rom[N−1]). For a caller that computes the node
+  // and a weight wider than this table's input code allows (weight_bits <= 62).
+  std::int64_t interpolate(std::size_t node, std::uint64_t weight, int weight_bits) const;
+
   // The domain position t the code stands for (the exact, real-valued mapping the table models).
   double position_of(std::uint32_t code) const { return static_cast<double>(code) / input_span_; }
 
