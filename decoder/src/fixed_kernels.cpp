@@ -695,9 +695,10 @@ std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) c
   const std::int64_t samples = 3 * pixels;
   const std::int64_t horizontal = 3 * static_cast<std::int64_t>(g.reduced.width) * g.full.height;
   const std::int64_t vertical = 3 * static_cast<std::int64_t>(g.reduced.width) * g.reduced.height;
+  std::vector<FixedArithmeticReport> out;
   if (linear_space_) {
     const int b = config_.decoder.link.bits;
-    std::vector<FixedArithmeticReport> out = {
+    out = {
         {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
         {"D horizontal on lin(E) (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line",
          horizontal, n_h, n_h, 0, n_h},
@@ -713,33 +714,26 @@ std::vector<FixedArithmeticReport> FixedKernels::arithmetic(const Geometry& g) c
         {"Eq. 6 weight w = exp(-s c)", "reduced", "pixel", pixels, 5, 3, 1, 3},
         {"Eq. 4 alpha' = clamp(alpha + w rho)", "reduced", "channel sample", samples, 2, 1, 2, 0},
     };
-    if (lcd_) {
-      out.push_back({"LCD drive code (Eq. 7 inverse, " + std::to_string(o) + "-step search)", "both",
-                     "channel sample", samples, 4 + 6 * o, 2 + 8 * o, 2 + o, 4});
-    } else {
-      out.push_back({"OLED drive code (" + std::to_string(o) + "-step threshold search)", "both", "channel sample",
-                     samples, 0, 0, o, o});
-    }
-    return out;
+  } else {
+    out = {
+        {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
+        {"D horizontal (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line", horizontal,
+         n_h, n_h, 1, 0},
+        {"D vertical + Q_b (" + std::to_string(n_v) + " taps)", "full", "reduced sample", vertical, n_v, n_v, 0, 0},
+        {"U bilinear of d_t", "full", "channel sample", samples, 6, 6, 0, 0},
+        {"EOTF LUT: L = lin(U(d_t))", "full", "channel sample", samples, 3, 1, 0, 2},
+        {"Eq. 2 beta = 2I - L, shown, rho", "full", "channel sample", samples, 2, 0, 2, 0},
+        {"residual store (round, saturate)", "full", "channel sample", samples, 1, 0, 2, 0},
+        {"U bilinear of i", "reduced", "channel sample", samples, 6, 6, 0, 0},
+        {"EOTF LUT: alpha = lin(U(i))", "reduced", "channel sample", samples, 3, 1, 0, 2},
+        {"U bilinear of d_{t-1}", "reduced", "channel sample", samples, 6, 6, 0, 0},
+        {"EOTF LUT: L_{t-1} = lin(U(d_{t-1}))", "reduced", "channel sample", samples, 3, 1, 0, 2},
+        {"luma of L_{t-1} and alpha", "reduced", "pixel", pixels, 6, 6, 0, 0},
+        {"Eq. 5 motion contrast c", "reduced", "pixel", pixels, 6, 2, 3, 2},
+        {"Eq. 6 weight w = exp(-s c)", "reduced", "pixel", pixels, 5, 3, 1, 3},
+        {"Eq. 4 alpha' = clamp(alpha + w rho)", "reduced", "channel sample", samples, 2, 1, 2, 0},
+    };
   }
-  std::vector<FixedArithmeticReport> out = {
-      {"I = lin(E)", "full", "channel sample", samples, 0, 0, 0, 1},
-      {"D horizontal (" + std::to_string(n_h) + " taps)", "full", "reduced-width sample per input line", horizontal,
-       n_h, n_h, 1, 0},
-      {"D vertical + Q_b (" + std::to_string(n_v) + " taps)", "full", "reduced sample", vertical, n_v, n_v, 0, 0},
-      {"U bilinear of d_t", "full", "channel sample", samples, 6, 6, 0, 0},
-      {"EOTF LUT: L = lin(U(d_t))", "full", "channel sample", samples, 3, 1, 0, 2},
-      {"Eq. 2 beta = 2I - L, shown, rho", "full", "channel sample", samples, 2, 0, 2, 0},
-      {"residual store (round, saturate)", "full", "channel sample", samples, 1, 0, 2, 0},
-      {"U bilinear of i", "reduced", "channel sample", samples, 6, 6, 0, 0},
-      {"EOTF LUT: alpha = lin(U(i))", "reduced", "channel sample", samples, 3, 1, 0, 2},
-      {"U bilinear of d_{t-1}", "reduced", "channel sample", samples, 6, 6, 0, 0},
-      {"EOTF LUT: L_{t-1} = lin(U(d_{t-1}))", "reduced", "channel sample", samples, 3, 1, 0, 2},
-      {"luma of L_{t-1} and alpha", "reduced", "pixel", pixels, 6, 6, 0, 0},
-      {"Eq. 5 motion contrast c", "reduced", "pixel", pixels, 6, 2, 3, 2},
-      {"Eq. 6 weight w = exp(-s c)", "reduced", "pixel", pixels, 5, 3, 1, 3},
-      {"Eq. 4 alpha' = clamp(alpha + w rho)", "reduced", "channel sample", samples, 2, 1, 2, 0},
-  };
   if (lcd_) {
     out.push_back({"LCD drive code (Eq. 7 inverse, " + std::to_string(o) + "-step search)", "both", "channel sample",
                    samples, 4 + 6 * o, 2 + 8 * o, 2 + o, 4});
