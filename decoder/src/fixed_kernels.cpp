@@ -1,6 +1,7 @@
 // Configuration checks, ROM generation and the per-pixel stage functions of the fixed-point decoder
 // (DESIGN §4-5). ROM contents are generated here from the double-precision functions; evaluation is integer only.
 #include "fixed_kernels.hpp"
+#include "lost_view.hpp"
 
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
@@ -1061,20 +1062,8 @@ cv::Mat FixedDecoderCore::concealed_codes(const cv::Mat& codes, const Concealmen
 
 DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
   check_view_meta(meta, std::string(who).append(": lost view: "));
-  const cv::Size full(meta.full_width, meta.full_height);
-  EyeState& eye = eyes_[meta.eye];
-  const bool held = eye.full_size == full && !eye.last_output.drive.empty();
-  if (!held) {
-    eye = EyeState();
-    eye.full_size = full;
-  }
-  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr);
   last_counts_ = FixedStageCounts();
-  // The residual belonged to a pair that is now broken (the LCD stores keep the drive the panel still shows).
-  eye.have_residual = false;
-  eye.residual.release();
-  eye.previous_low.release();
-  return out;
+  return detail::hold_lost_view(eyes_[meta.eye], meta);
 }
 
 }  // namespace fixed_detail

@@ -9,6 +9,8 @@
 // Then the panel inverse (Sec. 4.4): OLED v = x^(1/gamma_c); LCD solves Eq. 7 for v_t given v_{t-1}.
 #include "trm/reference_decoder.hpp"
 
+#include "lost_view.hpp"
+
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
@@ -500,19 +502,7 @@ DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
 
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
   check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(frame_name(meta)).append(": "));
-  const cv::Size full(meta.full_width, meta.full_height);
-  EyeState& eye = eyes_[meta.eye];
-  const bool held = eye.full_size == full && !eye.last_output.drive.empty();
-  if (!held) {
-    eye = EyeState();
-    eye.full_size = full;
-  }
-  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr);
-  // The residual belonged to a pair that is now broken.
-  eye.have_residual = false;
-  eye.residual.release();
-  eye.previous_low.release();
-  return out;
+  return detail::hold_lost_view(eyes_[meta.eye], meta);
 }
 
 DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
