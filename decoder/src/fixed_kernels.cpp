@@ -28,6 +28,12 @@ std::uint16_t threshold_search(const std::vector<std::int64_t>& thresholds, std:
   return static_cast<std::uint16_t>(lo);
 }
 
+// The LCD merge coefficient registers: sQ7.F (|p| <= kMaxLcdCoefficient = 16 with the sign), F the linear-light
+// fraction bits.
+fx::RuntimeFormat lcd_coefficient_format(int linear_frac_bits) {
+  return fx::RuntimeFormat{7, linear_frac_bits, true, fx::Quant::Rnd, fx::Overflow::Sat};
+}
+
 [[noreturn]] void reject(const std::string& stage, const std::string& why) {
   throw std::invalid_argument("FixedDecoderConfig: " + stage + ": " + why);
 }
@@ -125,21 +131,21 @@ void FixedDecoderConfig::validate() const {
   decoder.validate();
   const EncoderConfig& link = decoder.link;
   if (decoder.panel.kind == PanelKind::Lcd) {
+    // The panel itself is valid (decoder.validate); what the sQ7.F coefficient registers hold must still be a
+    // merge increasing in v_t, or the threshold search has no answer (a p3 below half an LSB rounds to 0).
     const LcdPanel& lcd = decoder.panel.lcd;
-    for (double p : {lcd.p1, lcd.p2, lcd.p3, lcd.p4}) {
-      if (std::abs(p) > 16.0) reject("LCD drive", "merge coefficients p1..p4 must be within [-16, 16]");
-    }
-    // dM/dv_t = 2 p1 v_t + p2 v_{t-1} + p3 is linear in both: positive at the four corners means positive on [0, 1]^2.
-    for (double v : {0.0, 1.0}) {
-      for (double vp : {0.0, 1.0}) {
-        if (!(2.0 * lcd.p1 * v + lcd.p2 * vp + lcd.p3 > 0.0)) {
-          reject("LCD drive", "the threshold search needs M(v_t, v_prev) increasing in v_t on [0, 1] (dM/dv_t = "
-                              "2 p1 v_t + p2 v_prev + p3 > 0); these coefficients are not supported in fixed point");
-        }
-      }
-      if (!(2.0 * (2.0 * lcd.p1 + lcd.p2) * v + 2.0 * lcd.p3 > 0.0)) {
-        reject("LCD drive", "the held merge M(v, v) must be increasing on [0, 1]");
-      }
+    const fx::RuntimeFormat coefficient = lcd_coefficient_format(linear_frac_bits);
+    LcdPanel held_in_registers = lcd;
+    double* registers[] = {&held_in_registers.p1, &held_in_registers.p2, &held_in_registers.p3, &held_in_registers.p4};
+    for (double* p : registers) *p = std::ldexp(static_cast<double>(fx::quantise_double(*p, coefficient)), -linear_frac_bits);
+    Panel quantised = decoder.panel;
+    quantised.lcd = held_in_registers;
+    try {
+      validate_panel(quantised, "");
+    } catch (const std::invalid_argument& e) {
+      reject("LCD drive (merge coefficients " + coefficient.to_string() + ")",
+             std::string("the coefficients as the registers hold them break a rule: ") + e.what() +
+                 "; these coefficients are not supported in fixed point");
     }
     if (lcd_segments_per_octave < 1 || lcd_segments_per_octave > 2048 ||
         !std::has_single_bit(static_cast<unsigned>(lcd_segments_per_octave))) {
@@ -183,10 +189,6 @@ void FixedDecoderConfig::validate() const {
   }
   require_range("motion contrast (luma)", "luma_weight_frac_bits", luma_weight_frac_bits, 8, 30);
   require_range("motion contrast (reciprocal LUT)", "reciprocal_entries", reciprocal_entries, 65, 65536);
-  const double s = decoder.sensitivity;
-  if (std::isfinite(s) && s > 255.0) {
-    reject("motion weight", "finite sensitivity s must be <= 255 (uQ8 integer part), got " + std::to_string(s));
-  }
   require_range("motion weight", "sensitivity_frac_bits", sensitivity_frac_bits, 4, 24);
   require_range("motion weight (exp LUT)", "exp_input_frac_bits", exp_input_frac_bits, 8, 24);
   require_range("motion weight (exp LUT)", "exp_entries", exp_entries, 65, 65536);
@@ -293,7 +295,7 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
   if (lcd_) {
     // LCD (Eq. 7 inverse): coefficients sQ7.F, the target LUT x^(1/gamma) and the clamped-drive luminance ROMs.
     const LcdPanel& lcd = config_.decoder.panel.lcd;
-    const fx::RuntimeFormat coefficient{7, F, true, fx::Quant::Rnd, fx::Overflow::Sat};
+    const fx::RuntimeFormat coefficient = lcd_coefficient_format(F);
     lcd_coefficients_ = {fx::quantise_double(lcd.p1, coefficient), fx::quantise_double(lcd.p2, coefficient),
                          fx::quantise_double(lcd.p3, coefficient), fx::quantise_double(lcd.p4, coefficient)};
     lcd_held_coefficients_ = {2 * lcd_coefficients_[0] + lcd_coefficients_[1], 0, 2 * lcd_coefficients_[2],
@@ -965,7 +967,7 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
     p.is_signed = is_signed;
     p.size = size;
     p.channels = channels;
-    p.values.assign(static_cast<std::size_t>(size.area()) * static_cast<std::size_t>(channels), 0);
+    p.values.assign(static_cast<std::size_t>(size.width) * static_cast<std::size_t>(size.height) * static_cast<std::size_t>(channels), 0);
   };
   const std::string code = "uQ" + std::to_string(b) + ".0";
   add(FixedStage::Codes, "codes", code, b, false, full ? g.full : g.reduced, 3);

@@ -159,8 +159,8 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
       {"frame: residual rho (" + c.residual.to_string() + ")", g.full.height, 3 * g.full.width, c.residual.width()},
       {"frame: d_t for the motion test (codes)", g.reduced.height, 3 * g.reduced.width, low_bits},
   };
-  const std::int64_t full_samples = 3 * static_cast<std::int64_t>(g.full.area());
-  const std::int64_t reduced_samples = 3 * static_cast<std::int64_t>(g.reduced.area());
+  const std::int64_t full_samples = 3 * static_cast<std::int64_t>(g.full.width) * g.full.height;
+  const std::int64_t reduced_samples = 3 * static_cast<std::int64_t>(g.reduced.width) * g.reduced.height;
   r.paper_frame_store_bits = full_samples * b + full_samples * c.residual.width();
   r.model_frame_store_bits = reduced_samples * low_bits + full_samples * c.residual.width();
   // Appended field by field: a braced temporary built from a literal trips GCC 12's false -Warray-bounds.

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -411,27 +412,6 @@ std::pair<cv::Mat, cv::Mat> held_history(const cv::Mat& wanted, const Panel& pan
 // Adds the LCD shortfall to rho (full frames only).
 void add_shortfall(cv::Mat& residual, const cv::Mat& shortfall) { residual += shortfall; }
 
-void validate_panel(const Panel& panel) {
-  if (panel.kind == PanelKind::Oled) {
-    for (double gamma : panel.oled.gamma) {
-      if (!(gamma > 0.0) || !std::isfinite(gamma)) {
-        throw std::invalid_argument("DecoderConfig: OLED gammas must be finite and > 0");
-      }
-    }
-    if (!(panel.oled.duty > 0.0 && panel.oled.duty <= 1.0)) {
-      throw std::invalid_argument("DecoderConfig: OLED duty must be in (0, 1]");
-    }
-    return;
-  }
-  const LcdPanel& lcd = panel.lcd;
-  for (double p : {lcd.p1, lcd.p2, lcd.p3, lcd.p4}) {
-    if (!std::isfinite(p)) throw std::invalid_argument("DecoderConfig: LCD parameters p1..p4 must be finite");
-  }
-  if (!(lcd.gamma > 0.0) || !std::isfinite(lcd.gamma)) {
-    throw std::invalid_argument("DecoderConfig: LCD gamma must be finite and > 0");
-  }
-}
-
 }  // namespace
 
 void DecoderConfig::validate() const {
@@ -439,15 +419,17 @@ void DecoderConfig::validate() const {
   // s = 10 (the default): c is a Michelson contrast in [0, 1]; exp(-10 c) keeps w >= 0.8 for the ~2 % contrast
   // changes that link quantisation alone produces, and fades the residual below 0.14 at 20 % contrast, where
   // adding it would ghost. The paper leaves s as a tuning parameter (Eq. 6).
-  if (std::isnan(sensitivity) || sensitivity < 0.0) {
-    throw std::invalid_argument("DecoderConfig: motion sensitivity s must be >= 0 (got " +
-                                std::to_string(sensitivity) + ")");
+  if (std::isnan(sensitivity) || sensitivity < 0.0 || (std::isfinite(sensitivity) && sensitivity > kMaxFiniteSensitivity)) {
+    std::ostringstream message;
+    message << "DecoderConfig: motion sensitivity s (--sensitivity) must be in [0, " << kMaxFiniteSensitivity
+            << "] or infinite (the motion weight's s register is uQ8), got " << sensitivity;
+    throw std::invalid_argument(message.str());
   }
   if (output_bits != 8 && output_bits != 10) {
     throw std::invalid_argument("DecoderConfig: output_bits must be 8 or 10 (got " + std::to_string(output_bits) +
                                 ")");
   }
-  validate_panel(panel);
+  validate_panel(panel, "DecoderConfig: ");
 }
 
 ReferenceDecoder::ReferenceDecoder(DecoderConfig config) : config_(std::move(config)) { config_.validate(); }
@@ -554,7 +536,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   const FrameMeta& meta = frame.meta;
   const EncoderConfig& link = config_.link;
   const cv::Size full(meta.full_width, meta.full_height);
-  const double samples = 3.0 * static_cast<double>(full.area());
+  const double samples = 3.0 * static_cast<double>(full.width) * full.height;
 
   EyeState& eye = eyes_[meta.eye];
   if (eye.full_size != full) {

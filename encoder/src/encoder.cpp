@@ -4,6 +4,7 @@
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -12,20 +13,32 @@ namespace trm {
 
 double EncoderConfig::effective_sigma() const { return sigma > 0.0 ? sigma : default_sigma(reduction); }
 
+namespace {
+
+// The shortest text that reads back as the same double: a message never shows 1.0000001 as 1.000000.
+std::string exact_text(double value) {
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, value);
+  return ec == std::errc() ? std::string(text, end) : std::to_string(value);
+}
+
+}  // namespace
+
 void EncoderConfig::validate() const {
   if (!(reduction > 0.0 && reduction <= 1.0)) {
-    throw std::invalid_argument("reduction r must be in (0, 1], got " + std::to_string(reduction));
+    throw std::invalid_argument("reduction r (--reduction) must be in (0, 1], got " + exact_text(reduction));
   }
-  // sigma == 0 selects the default; a user-given sigma must be a positive finite number.
-  if (std::isnan(sigma) || sigma < 0.0 || !std::isfinite(sigma)) {
-    throw std::invalid_argument("sigma must be > 0 when given (0 selects 1.25 / r), got " + std::to_string(sigma));
+  // sigma == 0 selects the default; a user-given sigma must be a finite number in [kMinSigma, kMaxSigma].
+  if (std::isnan(sigma) || sigma < 0.0 || !std::isfinite(sigma) || (sigma > 0.0 && sigma < kMinSigma)) {
+    throw std::invalid_argument("sigma (--sigma) must be >= " + exact_text(kMinSigma) +
+                                " full-resolution pixels when given (0 selects 1.25 / r), got " + exact_text(sigma));
   }
   if (effective_sigma() > kMaxSigma) {
-    std::string message = "sigma must be <= ";
-    message.append(std::to_string(kMaxSigma))
+    std::string message = "sigma (--sigma) must be <= ";
+    message.append(exact_text(kMaxSigma))
         .append(" full-resolution pixels (D's rounding error must stay below the reduced frame's tie tolerance), got ")
-        .append(std::to_string(effective_sigma()));
-    if (sigma == 0.0) message.append(" (the default 1.25 / r at r = ").append(std::to_string(reduction)).append(")");
+        .append(exact_text(effective_sigma()));
+    if (sigma == 0.0) message.append(" (the default 1.25 / r at r = ").append(exact_text(reduction)).append(")");
     throw std::invalid_argument(message);
   }
   if (bits != 8 && bits != 10) throw std::invalid_argument("link bits must be 8 or 10, got " + std::to_string(bits));

@@ -1,5 +1,6 @@
 #include "trm/frame.hpp"
 
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -28,6 +29,14 @@ const char* to_string(Parity p) { return p == Parity::Full ? "full" : "reduced";
 const char* to_string(Transfer t) { return t == Transfer::Srgb ? "srgb" : "gamma2.2"; }
 
 const char* to_string(ResampleSpace s) { return s == ResampleSpace::Encoded ? "encoded" : "linear"; }
+
+void validate_refresh_hz(double hz, const std::string& what) {
+  if (!(hz >= kMinRefreshHz && hz <= kMaxRefreshHz)) {
+    std::ostringstream message;
+    message << what << " must be a refresh rate from " << kMinRefreshHz << " to " << kMaxRefreshHz << " Hz, got " << hz;
+    throw std::invalid_argument(message.str());
+  }
+}
 
 Transfer parse_transfer(const std::string& name) {
   if (name == "srgb") return Transfer::Srgb;

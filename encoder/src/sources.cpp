@@ -108,7 +108,12 @@ class VideoSource final : public FrameSource {
  public:
   explicit VideoSource(const std::string& path) : path_(path) {
     std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw std::runtime_error("video file '" + path + "' does not exist");
+    if (fs::is_directory(path, ec)) {
+      throw std::runtime_error("--input '" + path + "' is a directory: give an image sequence glob such as '" +
+                               (fs::path(path) / "*.png").string() + "' or a video file");
+    }
+    if (!fs::exists(path, ec)) throw std::runtime_error("--input: video file '" + path + "' does not exist");
+    if (!fs::is_regular_file(path, ec)) throw std::runtime_error("--input: '" + path + "' is not a regular file");
     reopen();
     if (!capture_.read(current_bgr_) || current_bgr_.empty()) {
       throw std::runtime_error("video file '" + path + "' has no decodable frames");

@@ -41,9 +41,18 @@ std::string quoted(std::string_view text) {
   return out;
 }
 
-const char* accepted_forms() {
-  return "accepted panel specs: 'vive', 'rift', 'generic', 'gamma:G', 'gamma:GR,GG,GB' (gammas > 0), "
-         "'lcd', 'lcd:p1,p2,p3,p4,gamma' (finite parameters, gamma > 0)";
+// Shortest round-trip text of a number, for messages.
+std::string number_text(double value) {
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, value);
+  return ec == std::errc() ? std::string(text, end) : std::string("?");
+}
+
+std::string accepted_forms() {
+  const std::string gammas = "within [" + number_text(kMinPanelGamma) + ", " + number_text(kMaxPanelGamma) + "]";
+  return "accepted panel specs: 'vive', 'rift', 'generic', 'gamma:G', 'gamma:GR,GG,GB' (gammas " + gammas +
+         "), 'lcd', 'lcd:p1,p2,p3,p4,gamma' (finite parameters within [-" + number_text(kMaxLcdCoefficient) + ", " +
+         number_text(kMaxLcdCoefficient) + "], M increasing in the drive, gamma " + gammas + ")";
 }
 
 [[noreturn]] void reject(const std::string& spec, const std::string& why) {
@@ -71,6 +80,8 @@ std::vector<double> parse_numbers(const std::string& spec, std::string_view list
   }
   return values;
 }
+
+Panel parse_panel_spec(const std::string& spec);
 
 Panel oled_panel(const std::string& name, const std::array<double, 3>& gamma) {
   Panel panel;
@@ -164,7 +175,56 @@ double Panel::drive_from_linear(double x, int channel) const {
   return held.solve(std::pow(clamped, 1.0 / lcd.gamma), 0.0).v;
 }
 
+void validate_panel(const Panel& panel, const std::string& what) {
+  const auto fail = [&](const std::string& why) { throw std::invalid_argument(what + why); };
+  const auto check_gamma = [&](double gamma, const char* name) {
+    if (!(gamma > 0.0) || !std::isfinite(gamma)) fail(std::string(name) + " must be > 0 and finite");
+    if (gamma < kMinPanelGamma || gamma > kMaxPanelGamma) {
+      fail(std::string(name) + " " + number_text(gamma) + " is outside [" + number_text(kMinPanelGamma) + ", " +
+           number_text(kMaxPanelGamma) + "], the display gammas trm models");
+    }
+  };
+  if (panel.kind == PanelKind::Oled) {
+    for (double gamma : panel.oled.gamma) check_gamma(gamma, "OLED gamma");
+    if (!(panel.oled.duty > 0.0 && panel.oled.duty <= 1.0)) fail("OLED duty must be in (0, 1]");
+    return;
+  }
+  const LcdPanel& lcd = panel.lcd;
+  for (double p : {lcd.p1, lcd.p2, lcd.p3, lcd.p4}) {
+    if (!std::isfinite(p)) fail("LCD parameters p1..p4 must be finite");
+    if (std::abs(p) > kMaxLcdCoefficient) {
+      fail("LCD merge coefficients p1..p4 must be within [-" + number_text(kMaxLcdCoefficient) + ", " +
+           number_text(kMaxLcdCoefficient) + "]");
+    }
+  }
+  check_gamma(lcd.gamma, "LCD gamma");
+  // dM/dv_t = 2 p1 v_t + p2 v_prev + p3 is linear in both: positive at the four corners means positive on [0, 1]^2.
+  for (double v : {0.0, 1.0}) {
+    for (double vp : {0.0, 1.0}) {
+      if (!(2.0 * lcd.p1 * v + lcd.p2 * vp + lcd.p3 > 0.0)) {
+        fail("the LCD merge M(v_t, v_prev) must be increasing in v_t on [0, 1] (dM/dv_t = 2 p1 v_t + p2 v_prev + p3 "
+             "> 0), or the drive has no unique inverse");
+      }
+    }
+    if (!(2.0 * (2.0 * lcd.p1 + lcd.p2) * v + 2.0 * lcd.p3 > 0.0)) {
+      fail("the held LCD merge M(v, v) must be increasing on [0, 1]");
+    }
+  }
+}
+
 Panel parse_panel(const std::string& spec) {
+  Panel panel = parse_panel_spec(spec);
+  try {
+    validate_panel(panel, "");
+  } catch (const std::invalid_argument& e) {
+    reject(spec, e.what());
+  }
+  return panel;
+}
+
+namespace {
+
+Panel parse_panel_spec(const std::string& spec) {
   if (spec == "vive") return oled_panel(spec, kViveGamma);
   if (spec == "rift") return oled_panel(spec, kRiftGamma);
   if (spec == "generic") return oled_panel(spec, {kGenericGamma, kGenericGamma, kGenericGamma});
@@ -197,6 +257,8 @@ Panel parse_panel(const std::string& spec) {
   }
   reject(spec, "unknown panel");
 }
+
+}  // namespace
 
 cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b) {
   if (linear_a.size() != linear_b.size() || linear_a.type() != linear_b.type() || linear_a.depth() != CV_64F) {

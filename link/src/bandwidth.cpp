@@ -11,10 +11,10 @@
 namespace trm::link {
 
 void LinkBudget::validate() const {
-  if (!(refresh_hz > 0.0) || !std::isfinite(refresh_hz))
-    throw std::invalid_argument("link budget: refresh rate must be > 0 Hz");
-  if (!(preset.data_gbps() > 0.0) || !std::isfinite(preset.data_gbps()))
-    throw std::invalid_argument("link budget: link data rate must be > 0 Gbit/s");
+  validate_refresh_hz(refresh_hz, "link budget: the refresh");
+  if (!(preset.data_gbps() > 0.0 && preset.data_gbps() <= kMaxLinkGbps))
+    throw std::invalid_argument("link budget: link data rate must be > 0 and <= " + std::to_string(static_cast<int>(kMaxLinkGbps)) +
+                                " Gbit/s");
 }
 
 double LinkBudget::available_seconds() const {

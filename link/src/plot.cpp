@@ -27,13 +27,19 @@ std::string format_mbit(double bits) {
   return text;
 }
 
-// A "nice" tick step (1, 2 or 5 times a power of ten) giving about `target` ticks over `span`.
+// A "nice" tick step (1, 2 or 5 times a power of ten) giving about `target` ticks over `span`. The tick loops step
+// by it, so a span it cannot divide into a bounded number of finite steps is an error, never an endless loop.
 double tick_step(double span, int target) {
+  if (!(std::isfinite(span) && span > 0.0)) throw std::invalid_argument("bandwidth plot: axis span is not finite");
   const double raw = span / target;
   const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * magnitude >= raw) return m * magnitude;
-  return 10.0 * magnitude;
+  double step = 10.0 * magnitude;
+  for (double m : {5.0, 2.0, 1.0})
+    if (m * magnitude >= raw) step = m * magnitude;
+  if (!(std::isfinite(step) && step > 0.0 && span / step <= 4.0 * target && span + step > span)) {
+    throw std::invalid_argument("bandwidth plot: no finite tick step for an axis of " + std::to_string(span));
+  }
+  return step;
 }
 
 }  // namespace

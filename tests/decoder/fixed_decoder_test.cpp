@@ -248,8 +248,14 @@ TEST(FixedDecoder, RejectsBadConfiguration) {
   FixedDecoderConfig c = good;
   c.decoder.panel = parse_panel("lcd");
   EXPECT_NO_THROW(FixedStreamingDecoder{c});
-  c.decoder.panel = parse_panel("lcd:-1,0,0.5,0,2.2");  // dM/dv_t = 0.5 - 2 v_t < 0 near v_t = 1
-  expect_rejected(c, "LCD drive");
+  c.decoder.panel.lcd.p1 = -1.0;  // dM/dv_t = 0.5 - 2 v_t < 0 near v_t = 1: a panel rule, for every decoder
+  c.decoder.panel.lcd.p2 = 0.0;
+  expect_rejected(c, "increasing in v_t");
+  EXPECT_THROW(ReferenceDecoder{c.decoder}, std::invalid_argument);
+  c.decoder.panel = parse_panel("lcd:0,0,0.5,0,2.2");
+  c.decoder.panel.lcd.p3 = 1e-9;  // a valid panel, but p3 rounds to 0 in sQ7.28: M would not grow with v_t
+  expect_rejected(c, "LCD drive (merge coefficients sQ7.28");
+  EXPECT_NO_THROW(ReferenceDecoder{c.decoder});
   c.decoder.panel = parse_panel("lcd");
   c.lcd_segments_per_octave = 3;
   expect_rejected(c, "LCD drive (target LUT)");

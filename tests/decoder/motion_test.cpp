@@ -97,7 +97,13 @@ TEST(Motion, ZeroSensitivityAddsTheWholeResidualEverywhere) {
 }
 
 TEST(Motion, HugeSensitivityIgnoresTheResidualWhereverContrastIsPositive) {
-  for (double s : {1e300, std::numeric_limits<double>::infinity()}) {
+  {
+    // A finite s beyond the uQ8 register is no decoder's: rejected by name, as by the fixed-point decoders.
+    DecoderConfig config = decoder_config(EncoderConfig{});
+    config.sensitivity = 1e300;
+    EXPECT_NE(test::error_of([&] { ReferenceDecoder decoder(config); }).find("sensitivity"), std::string::npos);
+  }
+  for (double s : {std::numeric_limits<double>::infinity()}) {
     SCOPED_TRACE(s);
     EncoderConfig link;
     DecoderConfig config = decoder_config(link);

@@ -209,15 +209,26 @@ TEST(Sweep, RejectedValuesAreReportedNotFatal) {
   EXPECT_EQ(rows[3].at("is_default"), "1");
   EXPECT_TRUE(fs::exists(tmp.path() / "out" / "sweep_linear_frac_bits.png"));
 
-  // A value the knob itself refuses (the residual store needs a sign and an integer bit).
+  // A value the knob itself refuses (the residual store needs a sign and an integer bit), beside one it takes.
   const auto narrow = trm::cli::run_sweep([] {
     auto o = small_sweep("residual_bits", 16, 12, 2);
-    o.values = {2};
+    o.values = {2, 24};
     return o;
   }());
-  ASSERT_EQ(narrow.knobs.at(0).points.size(), 2u);
+  ASSERT_EQ(narrow.knobs.at(0).points.size(), 3u);
   EXPECT_EQ(narrow.knobs[0].points[0].status, "rejected");
   EXPECT_NE(narrow.knobs[0].points[0].message.find("out of range"), std::string::npos);
+  EXPECT_EQ(narrow.knobs[0].points[1].status, "ok");
+}
+
+TEST(Sweep, EveryAskedValueRejectedIsAnError) {
+  ScratchDir tmp("trm-sweep-");
+  const auto r = run_trm("sweep --quick --size 16x12 --knob linear_frac_bits --values 14,16 -o " + tmp.str("out"));
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("trm: error: --values: every value asked for linear_frac_bits was rejected"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path() / "out"));
 }
 
 TEST(Sweep, BadKnobsFailClearlyWithoutOutput) {

@@ -24,10 +24,22 @@ int run_main(int argc, char** argv) {
   register_vectors(app, action);
   register_sweep(app, action);
 
+  // Every failure, of parsing or of the run, is one "trm: error:" line on stderr and a non-zero exit.
+  const auto usage_hint = [&app] {
+    const auto chosen = app.get_subcommands();
+    return std::string("Run 'trm") + (chosen.empty() ? "" : " " + chosen.front()->get_name()) +
+           " --help' for the options.\n";
+  };
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "trm: error: " << e.what() << "\n" << usage_hint();
+    return e.get_exit_code();
+  } catch (const std::exception& e) {
+    // An option callback that threw something other than a CLI11 error (a library parser's message).
+    std::cerr << "trm: error: " << e.what() << "\n" << usage_hint();
+    return 2;
   }
   if (!action) {
     std::cout << app.help();

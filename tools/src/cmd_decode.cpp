@@ -60,12 +60,15 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
   OutputDir dir(out);
   Json frames = Json::array();
   const CaptureDecodeResult result =
-      decode_capture_stream(options, capture_path, [&](const link::ReceivedFrame& received, const DecodedFrame& decoded) {
-        write_drive_files(dir, received.meta, decoded, options.output_bits);
-        frames.push_back({{"t", received.meta.index},
-                          {"eye", received.meta.eye},
-                          {"parity", to_string(received.meta.parity)},
-                          {"intact_lines", received.intact_lines()},
+      decode_capture_stream(options, capture_path, [&](const FrameMeta& meta, const link::ReceivedFrame* received,
+                                                       const DecodedFrame& decoded) {
+        // A lost view is written too: it is what the panel shows (its previous output, held).
+        write_drive_files(dir, meta, decoded, options.output_bits);
+        frames.push_back({{"t", meta.index},
+                          {"eye", meta.eye},
+                          {"parity", to_string(meta.parity)},
+                          {"lost", received == nullptr},
+                          {"intact_lines", received ? received->intact_lines() : 0},
                           {"concealed_lines", decoded.stats.concealed_lines},
                           {"clipped_fraction", decoded.stats.clipped_fraction}});
       });
@@ -79,12 +82,14 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
                           {"output_bits", options.output_bits},
                           {"impl", options.impl}};
   report["receiver"] = receiver_json(c);
-  report["summary"] = {{"views", result.views}, {"concealed_lines", result.concealed_lines}};
+  report["summary"] = {
+      {"views", result.views}, {"lost_views", result.lost_views}, {"concealed_lines", result.concealed_lines}};
   report["frames"] = frames;
   dir.write_text("report.json", report.dump(2) + "\n");
   dir.commit();
   std::cout << "trm decode: " << result.views << " views from " << capture_path << " -> " << dir.target().string()
-            << "/ (" << c.crc_failures << " damaged packets, " << result.concealed_lines << " lines concealed)\n";
+            << "/ (" << c.crc_failures << " damaged packets, " << result.concealed_lines << " lines concealed, "
+            << result.lost_views << " views lost and held)\n";
   return 0;
 }
 

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -68,11 +69,12 @@ int parse_endpoint(const std::string& text, bool in) {
 
 std::optional<rig::Region> parse_roi(const std::string& text) {
   if (text.empty()) return std::nullopt;
-  rig::Region r;
-  int used = 0;
-  if (std::sscanf(text.c_str(), "%d,%d,%d,%d%n", &r.x, &r.y, &r.width, &r.height, &used) != 4 ||
-      used != static_cast<int>(text.size()) || r.x < 0 || r.y < 0 || r.width <= 0 || r.height <= 0)
-    throw std::invalid_argument("--roi takes X,Y,W,H in view pixels, e.g. 476,536,128,128");
+  const auto fields = parse_int_list(text, 4, "--roi", "X,Y,W,H in view pixels, e.g. 476,536,128,128");
+  const rig::Region r{fields[0], fields[1], fields[2], fields[3]};
+  if (r.x < 0 || r.y < 0 || r.width <= 0 || r.height <= 0)
+    throw std::invalid_argument("--roi " + text + ": X, Y must be >= 0 and W, H >= 1");
+  if (r.x > std::numeric_limits<int>::max() - r.width || r.y > std::numeric_limits<int>::max() - r.height)
+    throw std::invalid_argument("--roi " + text + ": the region ends beyond any view");
   return r;
 }
 
@@ -222,7 +224,9 @@ int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
     };
     if (!s.capture.empty()) {
       decode_capture_stream(pipeline, s.capture,
-                            [&](const link::ReceivedFrame&, const DecodedFrame& decoded) { feed_decoded(decoded); });
+                            [&](const FrameMeta&, const link::ReceivedFrame*, const DecodedFrame& decoded) {
+                              feed_decoded(decoded);
+                            });
     } else {
       run_pipeline(pipeline, [&](const DecodedView& view) { feed_decoded(*view.decoded); });
     }
@@ -269,7 +273,8 @@ void register_feed(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"hidraw", "libusb"}));
   cmd->add_option("--file-framing", s.file_framing, "File: bulk (a USB stream) or hid (reports, with --report-size/--report-id)")
       ->capture_default_str()->check(CLI::IsMember({"bulk", "hid"}));
-  cmd->add_option("--fps", s.fps, "Views per second (default: the panel refresh, --refresh; 0: as fast as possible)");
+  cmd->add_option("--fps", s.fps, "Views per second (default: the panel refresh, --refresh; 0: as fast as possible)")
+      ->check(finite_non_negative(" (0: as fast as possible; leave --fps out for the panel refresh)"));
   cmd->add_flag("--no-drop", s.no_drop, "Paced: send late views anyway instead of dropping them");
   cmd->add_flag("--flow-control", s.flow_control, "Wait for the rig's READY / RESEND / ERROR after every view");
   cmd->add_option("--answer-timeout", s.answer_timeout_ms, "Flow control: ms to wait for an answer")->capture_default_str()->check(CLI::Range(1, 600000));

@@ -67,7 +67,7 @@ void register_lossless(CLI::App& app, Action& action) {
         o->height = size.height;
       },
       "View size WxH (default 540x600)");
-  cmd->add_option("--frames", o->frames, "Frames per scene")->capture_default_str();
+  cmd->add_option("--frames", o->frames, "Frames per scene")->capture_default_str()->check(whole_number_at_least(2, " (a TRM pair)"));
   cmd->add_option("--bits", o->bits, "Link bits, 8 or 10")->capture_default_str();
   cmd->add_option("--out,-o", o->out, "Also write lossless.json and lossless.csv into this directory");
   cmd->callback([o, &action] {

@@ -71,7 +71,8 @@ Json hardware_json(const FixedStreamingReport& r) {
     rom_bits += rom.total_bits();
   }
   hw["roms"] = roms;
-  const double pixels = static_cast<double>(r.full.area());
+  // Not cv::Size::area(): an int, which overflows from 2^31 pixels.
+  const double pixels = static_cast<double>(r.full.width) * r.full.height;
   Json arithmetic = Json::array();
   Json per_pixel;
   for (const char* kind : {"full", "reduced"}) per_pixel[kind] = {{"adders", 0.0}, {"multipliers", 0.0}, {"comparators", 0.0}};

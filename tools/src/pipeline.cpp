@@ -2,12 +2,20 @@
 
 #include "hw_report.hpp"
 
+#include "trm/resample.hpp"
+
 #include <nlohmann/json.hpp>
 
+#include <cctype>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <optional>
 #include <span>
+#include <sstream>
 #include <stdexcept>
 
 namespace trm::cli {
@@ -24,7 +32,7 @@ bool looks_like_image_sequence(const std::string& input) {
 }
 
 // Stored in a capture's header so that `trm decode --capture` can rebuild the decoder's link configuration.
-std::string capture_metadata(const PipelineOptions& options) {
+std::string capture_metadata(const PipelineOptions& options, std::int64_t frames) {
   nlohmann::ordered_json meta;
   meta["reduction"] = options.encoder.reduction;
   meta["sigma"] = options.encoder.effective_sigma();
@@ -34,7 +42,61 @@ std::string capture_metadata(const PipelineOptions& options) {
   meta["bits"] = options.encoder.bits;
   meta["stereo"] = options.encoder.stereo;
   meta["refresh_hz"] = options.refresh_hz;
+  meta["frames"] = frames;  // link frames the run sends: views lost at the end of a capture are known too
   return meta.dump();
+}
+
+// A library parser's std::invalid_argument, reported as an error of the option that gave the text.
+template <class Parse>
+std::function<void(const std::string&)> option_parser(const std::string& option, Parse parse) {
+  return [option, parse](const std::string& text) {
+    try {
+      parse(text);
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError(option, e.what());
+    }
+  };
+}
+
+// Peak resident memory of a run per pixel of the view, measured with /usr/bin/time on `trm run` at 256x256 and
+// 1024x1024 (the fixed decoder beside the reference, every frame store and stage image): about 450 B with an OLED,
+// 720 B with an LCD (its panel history and shortfall images), a stereo run 1.55 times a mono one; plus about 100 MB
+// of program and ROMs. Used only to refuse, up front, runs that cannot fit.
+constexpr double kRunBaseBytes = 100e6;
+constexpr double kRunBytesPerPixelOled = 450.0;
+constexpr double kRunBytesPerPixelLcd = 720.0;
+constexpr double kRunStereoFactor = 1.55;
+
+std::optional<double> available_memory_bytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kib = 0.0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit) {
+    if (key == "MemAvailable:") return kib * 1024.0;
+  }
+  return std::nullopt;
+}
+
+std::string gigabytes(double bytes) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(bytes < 10e9 ? 2 : 1) << bytes / 1e9 << " GB";
+  return text.str();
+}
+
+void require_memory_for(const PipelineOptions& options, cv::Size view) {
+  const std::optional<double> available = available_memory_bytes();
+  if (!available) return;  // no /proc: nothing to compare with
+  const bool lcd = parse_panel(options.panel).kind == PanelKind::Lcd;
+  const double per_pixel = (lcd ? kRunBytesPerPixelLcd : kRunBytesPerPixelOled) *
+                           (options.encoder.stereo ? kRunStereoFactor : 1.0);
+  const double needed = kRunBaseBytes + per_pixel * static_cast<double>(view.width) * view.height;
+  if (needed > *available) {
+    throw std::runtime_error("a " + std::to_string(view.width) + "x" + std::to_string(view.height) + " view needs about " +
+                             gigabytes(needed) + " of memory (about " + std::to_string(static_cast<int>(per_pixel)) +
+                             " B per pixel with this panel" + (options.encoder.stereo ? " in stereo" : "") +
+                             "), but only " + gigabytes(*available) + " is available: use a smaller --size");
+  }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -43,13 +105,61 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-cv::Size parse_view_size(const std::string& text, const std::string& option) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1) {
-    throw CLI::ValidationError(option, "expected WxH with W, H >= 1, got '" + text + "'");
+std::vector<int> parse_int_list(const std::string& text, std::size_t count, const std::string& option,
+                                const std::string& expected, char separator) {
+  std::vector<int> values;
+  const char* p = text.data();
+  const char* const end = text.data() + text.size();
+  while (values.size() < count) {
+    int value = 0;
+    const auto [next, error] = std::from_chars(p, end, value);
+    if (error == std::errc::result_out_of_range) {
+      throw CLI::ValidationError(option, "'" + text + "': " + std::string(p, next) + " is out of range");
+    }
+    if (error != std::errc() || next == p) break;
+    values.push_back(value);
+    p = next;
+    if (values.size() < count) {
+      if (p == end || (*p != separator && std::tolower(static_cast<unsigned char>(*p)) != separator)) break;
+      ++p;
+    }
   }
-  return {w, h};
+  if (values.size() != count || p != end) throw CLI::ValidationError(option, "expected " + expected + ", got '" + text + "'");
+  return values;
+}
+
+CLI::Validator whole_number_at_least(long long lowest, const std::string& meaning) {
+  return CLI::Validator(
+      [lowest, meaning](std::string& text) -> std::string {
+        long long value = 0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (error == std::errc::result_out_of_range) return "'" + text + "' is out of range";
+        if (error != std::errc() || end != text.data() + text.size()) return "'" + text + "' is not a whole number";
+        if (value < lowest) return "must be >= " + std::to_string(lowest) + meaning + ", got " + text;
+        return "";
+      },
+      "N >= " + std::to_string(lowest));
+}
+
+CLI::Validator finite_non_negative(const std::string& meaning) {
+  return CLI::Validator(
+      [meaning](std::string& text) -> std::string {
+        double value = 0.0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (error != std::errc() || end != text.data() + text.size()) return "'" + text + "' is not a number";
+        if (!std::isfinite(value) || value < 0.0) return "must be a finite number >= 0" + meaning + ", got " + text;
+        return "";
+      },
+      "X >= 0");
+}
+
+cv::Size parse_view_size(const std::string& text, const std::string& option) {
+  const std::string expected = "WxH with 1 <= W, H <= " + std::to_string(kMaxViewSide);
+  const std::vector<int> wh = parse_int_list(text, 2, option, expected, 'x');
+  if (wh[0] < 1 || wh[1] < 1 || wh[0] > kMaxViewSide || wh[1] > kMaxViewSide) {
+    throw CLI::ValidationError(option, "expected " + expected + ", got '" + text + "'");
+  }
+  return {wh[0], wh[1]};
 }
 
 std::unique_ptr<FrameSource> PipelineOptions::open_source() const {
@@ -69,7 +179,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--input", input, "Image sequence glob ('DIR/frame_*.png', sorted by name, sRGB) or a video file");
   cmd.add_option("--image", image, "Image for the panorama and static scenes (default: procedural texture)");
   cmd.add_option("--frames", frames, "Number of frames (default: all input frames, or " +
-                                         std::to_string(default_frames) + " for a scene)");
+                                         std::to_string(default_frames) + " for a scene)")
+      ->check(whole_number_at_least(1, " (leave --frames out for every input frame)"));
   cmd.add_option_function<std::string>(
          "--size",
          [this](const std::string& text) {
@@ -83,10 +194,11 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--sigma", encoder.sigma, "Gaussian sigma of D in full-resolution pixels (default 1.25 / r)");
   cmd.add_option("--phase", encoder.phase, "0: even frames full, odd reduced; 1: swapped")->capture_default_str();
   cmd.add_option_function<std::string>(
-      "--transfer", [this](const std::string& s) { encoder.transfer = parse_transfer(s); },
+      "--transfer", option_parser("--transfer", [this](const std::string& s) { encoder.transfer = parse_transfer(s); }),
       "Link transfer function: srgb (default) or gamma2.2");
   cmd.add_option_function<std::string>(
-      "--resample-space", [this](const std::string& s) { encoder.resample_space = parse_resample_space(s); },
+      "--resample-space",
+      option_parser("--resample-space", [this](const std::string& s) { encoder.resample_space = parse_resample_space(s); }),
       "Space in which D and U act: encoded (default) or linear");
   cmd.add_option_function<int>(
       "--bits",
@@ -173,16 +285,15 @@ void PipelineOptions::validate() const {
   if (!(std::isfinite(sensitivity) && sensitivity >= 0.0)) {
     throw std::invalid_argument("--sensitivity must be a finite number >= 0");
   }
-  if (!(std::isfinite(refresh_hz) && refresh_hz > 0.0)) {
-    throw std::invalid_argument("--refresh must be a positive number of Hz");
-  }
+  validate_refresh_hz(refresh_hz, "--refresh");
   if (frames < 0) throw std::invalid_argument("--frames must be >= 0");
   if (output_bits != 8 && output_bits != 10) throw std::invalid_argument("output bits must be 8 or 10");
   if (impl != "reference" && impl != "fixed" && impl != "fixed-frame") {
     throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference, fixed, fixed-frame)");
   }
   (void)parse_panel(panel);
-  if (link_enabled()) (void)link_config(width, height);
+  // Link and fault options are checked whether or not they switch the link on (--ber -1 is an error either way).
+  (void)link_config(width, height);
   if (input.empty()) {
     bool known = false;
     for (const auto& name : scene_names()) known = known || name == scene;
@@ -197,6 +308,7 @@ void PipelineOptions::validate() const {
 PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink) {
   options.validate();
   const std::unique_ptr<FrameSource> source = options.open_source();
+  require_memory_for(options, cv::Size(source->width(), source->height()));
 
   std::int64_t frames = options.frames;
   const auto available = source->frame_count();
@@ -237,7 +349,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     link::LinkSimulationConfig config = options.link_config(source->width(), source->height());
     if (!options.capture_out.empty()) {
       config.capture = options.capture_out;
-      config.capture_metadata = capture_metadata(options);
+      config.capture_metadata = capture_metadata(options, frames);
     }
     simulation.emplace(std::move(config));
     result.link.emplace();
@@ -342,18 +454,21 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   return result;
 }
 
-CaptureDecodeResult decode_capture_stream(
-    const PipelineOptions& options, const std::string& capture_path,
-    const std::function<void(const link::ReceivedFrame& received, const DecodedFrame& decoded)>& sink) {
+CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const std::string& capture_path,
+                                          const CaptureSink& sink) {
   link::CaptureReplay replay(capture_path);
+  const std::string where = "capture '" + capture_path + "': ";
   nlohmann::json meta;
   try {
     meta = nlohmann::json::parse(replay.metadata());
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error("capture '" + capture_path + "' has no readable configuration in its header: " + e.what());
+    throw std::runtime_error(where + "no readable configuration in its header: " + e.what());
   }
+  // The header is checked as strictly as the command line that wrote it.
   DecoderConfig config;
+  std::optional<std::int64_t> frames_sent;
   try {
+    if (!meta.is_object()) throw std::invalid_argument("the header's configuration is not a JSON object");
     config.link.reduction = meta.at("reduction").get<double>();
     config.link.sigma = meta.at("sigma").get<double>();
     config.link.phase = meta.at("phase").get<int>();
@@ -361,8 +476,16 @@ CaptureDecodeResult decode_capture_stream(
     config.link.resample_space = parse_resample_space(meta.at("resample_space").get<std::string>());
     config.link.bits = meta.at("bits").get<int>();
     config.link.stereo = meta.at("stereo").get<bool>();
+    config.link.validate();
+    validate_refresh_hz(meta.at("refresh_hz").get<double>(), "refresh_hz");
+    if (meta.contains("frames")) {
+      frames_sent = meta.at("frames").get<std::int64_t>();
+      if (*frames_sent < 1) throw std::invalid_argument("frames must be >= 1");
+    }
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error("capture '" + capture_path + "': incomplete configuration in its header: " + e.what());
+    throw std::runtime_error(where + "incomplete configuration in its header: " + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + "invalid configuration in its header: " + e.what());
   }
   config.sensitivity = options.sensitivity;
   config.panel = parse_panel(options.panel);
@@ -381,19 +504,76 @@ CaptureDecodeResult decode_capture_stream(
   } else {
     reference.emplace(config);
   }
+  const auto decode_lost = [&](const FrameMeta& lost) {
+    return streaming ? streaming->decode_lost(lost) : frame_at_a_time ? frame_at_a_time->decode_lost(lost)
+                                                                      : reference->decode_lost(lost);
+  };
 
+  // Views in link order: (t, eye) as t * eyes + eye. A view that lost every packet never comes out of the receiver;
+  // the panel holds its previous output for it, and it is decoded and handed on as lost.
+  const int eyes = config.link.stereo ? 2 : 1;
+  std::int64_t next_view = 0;
+  cv::Size full_size;
+  bool right_eye_arrived = false;
   CaptureDecodeResult result;
   result.link_configuration = meta.dump();
+  const auto hand_on_lost_views_before = [&](std::int64_t view_number) {
+    for (; next_view < view_number; ++next_view) {
+      FrameMeta lost;
+      lost.index = next_view / eyes;
+      lost.eye = static_cast<int>(next_view % eyes);
+      lost.parity = parity_of(lost.index, lost.eye, config.link);
+      lost.full_width = full_size.width;
+      lost.full_height = full_size.height;
+      const bool full = lost.parity == Parity::Full;
+      lost.width = full ? full_size.width : reduced_size(full_size.width, config.link.reduction);
+      lost.height = full ? full_size.height : reduced_size(full_size.height, config.link.reduction);
+      lost.bits = config.link.bits;
+      lost.transfer = config.link.transfer;
+      const DecodedFrame decoded = decode_lost(lost);
+      ++result.views;
+      ++result.lost_views;
+      sink(lost, nullptr, decoded);
+    }
+  };
   while (auto received = replay.next_frame()) {
-    const LinkFrame frame{received->meta, received->codes};
+    const FrameMeta& m = received->meta;
+    if (m.eye >= eyes) {
+      throw std::runtime_error(where + "holds a view of eye " + std::to_string(m.eye) + " (stream " +
+                               std::to_string(m.eye) + ") but its header says " + (eyes == 1 ? "mono" : "stereo"));
+    }
+    if (m.parity != parity_of(m.index, m.eye, config.link)) {
+      throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye) +
+                               " is sent " + to_string(m.parity) + ", but the header's phase " +
+                               std::to_string(config.link.phase) + " makes it " +
+                               to_string(parity_of(m.index, m.eye, config.link)));
+    }
+    const std::int64_t view_number = m.index * eyes + m.eye;
+    if (view_number < next_view) {
+      throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye) +
+                               " arrives after a later one");
+    }
+    if (frames_sent && m.index >= *frames_sent) {
+      throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " lies beyond the " +
+                               std::to_string(*frames_sent) + " frames its header says were sent");
+    }
+    if (full_size.empty()) full_size = cv::Size(m.full_width, m.full_height);
+    if (m.eye == 1) right_eye_arrived = true;
+    hand_on_lost_views_before(view_number);
+    const LinkFrame frame{m, received->codes};
     const DecodedFrame decoded = streaming         ? streaming->decode(frame, received->line_intact)
                                  : frame_at_a_time ? frame_at_a_time->decode(frame, received->line_intact)
                                                    : reference->decode(frame, received->line_intact);
     result.concealed_lines += decoded.stats.concealed_lines;
     ++result.views;
-    sink(*received, decoded);
+    ++next_view;
+    sink(m, &*received, decoded);
   }
-  if (result.views == 0) throw std::runtime_error("capture '" + capture_path + "' holds no frames");
+  if (full_size.empty()) throw std::runtime_error(where + "holds no frame that arrived");
+  if (eyes == 2 && !right_eye_arrived) {
+    throw std::runtime_error(where + "its header says stereo, but no view of eye 1 (stream 1) arrived: a mono stream");
+  }
+  if (frames_sent) hand_on_lost_views_before(*frames_sent * eyes);
   result.receiver = replay.counters();
   return result;
 }

@@ -81,8 +81,18 @@ struct DecodedView {
   double decode_seconds = 0.0;
 };
 
-// "WxH" with W, H >= 1; throws CLI::ValidationError naming `option` otherwise.
+// "WxH" with 1 <= W, H <= kMaxViewSide (trm/frame.hpp); throws CLI::ValidationError naming `option` otherwise.
 cv::Size parse_view_size(const std::string& text, const std::string& option = "--size");
+
+// Option checks with exact messages: a whole number >= `lowest`, and a finite number >= 0. `meaning` follows the
+// rule in the message (e.g. "; leave --frames out for every input frame").
+CLI::Validator whole_number_at_least(long long lowest, const std::string& meaning = "");
+CLI::Validator finite_non_negative(const std::string& meaning = "");
+
+// Exactly `count` decimal ints separated by `separator` (nothing else, no wrap-around: out-of-range values are an
+// error); throws CLI::ValidationError naming `option` and what was `expected`.
+std::vector<int> parse_int_list(const std::string& text, std::size_t count, const std::string& option,
+                                const std::string& expected, char separator = ',');
 
 struct LinkOutcome {
   std::vector<link::LinkFrameUsage> frames;
@@ -106,12 +116,15 @@ struct PipelineResult {
 struct CaptureDecodeResult {
   std::string link_configuration;   // the capture header's JSON
   link::ReceiverCounters receiver;
-  std::int64_t views = 0;
+  std::int64_t views = 0;           // handed to the sink, lost ones included
+  std::int64_t lost_views = 0;      // views none of whose packets arrived (the panel held its previous output)
   std::int64_t concealed_lines = 0;
 };
-CaptureDecodeResult decode_capture_stream(
-    const PipelineOptions& options, const std::string& capture_path,
-    const std::function<void(const link::ReceivedFrame& received, const DecodedFrame& decoded)>& sink);
+// Called for every view in link order: `received` is null for a lost view (decoded is then the held output).
+using CaptureSink =
+    std::function<void(const FrameMeta& meta, const link::ReceivedFrame* received, const DecodedFrame& decoded)>;
+CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const std::string& capture_path,
+                                          const CaptureSink& sink);
 
 // Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order.
 PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink);

@@ -603,6 +603,20 @@ SweepResult run_sweep(const SweepOptions& options,
       }
       kr.points.push_back(std::move(p));
     }
+    if (!options.values.empty()) {
+      // Asked-for values that all fail leave nothing to report: an error, with the first reason.
+      const SweepPoint* first_failure = nullptr;
+      bool any_asked_ok = false;
+      for (const SweepPoint& p : kr.points) {
+        if (p.is_default) continue;
+        if (p.ok()) any_asked_ok = true;
+        else if (!first_failure) first_failure = &p;
+      }
+      if (!any_asked_ok && first_failure) {
+        throw std::invalid_argument("--values: every value asked for " + knob.name + " was rejected (" +
+                                    std::to_string(first_failure->value) + ": " + first_failure->message + ")");
+      }
+    }
     result.knobs.push_back(std::move(kr));
   }
   result.wall_seconds = seconds_since(start);

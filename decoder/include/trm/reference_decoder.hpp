@@ -21,9 +21,14 @@ enum class LcdHistory {
                 // Avoids counting an unreachable full frame's shortfall twice (it is already in rho).
 };
 
+// The largest finite motion sensitivity any decoder accepts: the hardware's s register is uQ8.f (and w = exp(-s c)
+// is below 2^-300 at 1 % contrast already at s = 255, so nothing larger means anything but +inf).
+inline constexpr double kMaxFiniteSensitivity = 255.0;
+
 struct DecoderConfig {
   EncoderConfig link;          // r, sigma, transfer, bits, resample space: must match the encoder
-  double sensitivity = 10.0;   // s in w = exp(-s c) (Eq. 6); s >= 0 (+inf allowed: residual only where c = 0)
+  double sensitivity = 10.0;   // s in w = exp(-s c) (Eq. 6); 0 <= s <= kMaxFiniteSensitivity or +inf (residual only
+                               // where c = 0)
   Panel panel;                 // OLED or LCD inverse
   int output_bits = 8;         // drive code depth, 8 or 10
   bool record_stages = false;  // fill DecodedFrame::stages (per-stage vectors for golden tests)

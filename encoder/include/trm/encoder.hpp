@@ -13,6 +13,9 @@ namespace trm {
 // 7.0e-10 code at 256 against 1e-9), so exact half-code ties would no longer be told apart from rounding noise. It
 // also keeps R = ceil(3 sigma) <= 768 and the taps of one reduced sample at most 1537 per axis.
 inline constexpr double kMaxSigma = 256.0;
+// The smallest sigma accepted: far below a pixel D is already the nearest taps averaged, and 1 / (2 sigma^2) must stay
+// a finite double (it overflows below about 1e-154).
+inline constexpr double kMinSigma = 1e-6;
 
 struct EncoderConfig {
   double reduction = 0.5;      // r in (0, 1]

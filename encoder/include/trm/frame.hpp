@@ -20,6 +20,13 @@ enum class Parity : std::uint8_t { Full = 0, Reduced = 1 };
 // headset panel), and keeps every index product of the resampling arithmetic ((2x + 1) W, 3 W H) well inside 64 bits.
 inline constexpr int kMaxViewSide = 65535;
 
+// The refresh rates trm accepts anywhere (Hz). 1 Hz to 1 kHz spans every panel (TRM itself wants >= 90 Hz); the
+// bounds keep frame periods, scene motion per frame and per-frame link budgets finite.
+inline constexpr double kMinRefreshHz = 1.0;
+inline constexpr double kMaxRefreshHz = 1000.0;
+// Throws std::invalid_argument naming `what` unless hz is within [kMinRefreshHz, kMaxRefreshHz].
+void validate_refresh_hz(double hz, const std::string& what);
+
 enum class Transfer : std::uint8_t { Srgb = 0, Gamma22 = 1 };
 
 // Space in which D and U act (DESIGN §3): encoded values (default, paper Sec. 4.2) or linear.

@@ -20,9 +20,7 @@ void validate_params(const SceneParams& params, const std::string& scene) {
     throw std::invalid_argument(prefix + "size must be at least 1x1, got " + std::to_string(params.width) + "x" +
                                 std::to_string(params.height));
   }
-  if (!(params.refresh_hz > 0.0) || !std::isfinite(params.refresh_hz)) {
-    throw std::invalid_argument(prefix + "refresh rate must be a positive finite number of Hz");
-  }
+  validate_refresh_hz(params.refresh_hz, prefix + "the scene's refresh");
   if (params.supersample < 1 || params.supersample > 64) {
     throw std::invalid_argument(prefix + "supersample must be in [1, 64], got " + std::to_string(params.supersample));
   }

@@ -43,8 +43,24 @@ struct Panel {
   double drive_from_linear(double x, int channel) const;
 };
 
+// The panels every decoder accepts. Display gammas are measured near 2.2 (1.8 to 2.6); [0.5, 4] leaves room for
+// experiments while every drive code still emits distinct light in double precision.
+inline constexpr double kMinPanelGamma = 0.5;
+inline constexpr double kMaxPanelGamma = 4.0;
+// LCD merge coefficients beyond this are no panel (M(v, v) = v needs |p| <= 1); the fixed-point decoder holds
+// them in sQ7.f.
+inline constexpr double kMaxLcdCoefficient = 16.0;
+
+// The physical rules a panel must meet for its drive to be an inverse (one validation for every decoder): OLED gammas
+// and LCD gamma within [kMinPanelGamma, kMaxPanelGamma], OLED duty in (0, 1], LCD coefficients finite and within
+// kMaxLcdCoefficient, M(v_t, v_prev) strictly increasing in v_t on [0, 1]^2 and the held merge M(v, v) strictly
+// increasing on [0, 1] (otherwise several drives give one light and the inverse is not defined). Throws
+// std::invalid_argument with `what` and the rule.
+void validate_panel(const Panel& panel, const std::string& what);
+
 // "vive" | "rift" | "generic" | "gamma:G" | "gamma:GR,GG,GB" | "lcd" | "lcd:p1,p2,p3,p4,gamma".
-// Throws std::invalid_argument with the list of accepted forms.
+// Throws std::invalid_argument with the list of accepted forms, for a malformed spec and for a panel that breaks
+// validate_panel's rules.
 Panel parse_panel(const std::string& spec);
 
 // Talbot-Plateau: the eye sees the time average of linear light over a pair.

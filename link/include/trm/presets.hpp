@@ -7,6 +7,10 @@
 
 namespace trm::link {
 
+// The fastest link any preset may claim (Gbit/s): a hundred times DP 2.1 UHBR20, so per-frame budgets and their
+// plots stay finite numbers.
+inline constexpr double kMaxLinkGbps = 10000.0;
+
 struct LinkPreset {
   std::string name;         // as on the command line: dp1.2, hdmi2.1, custom:RATE_GBPS:EFFICIENCY, ...
   std::string description;  // e.g. "DisplayPort 1.2 HBR2 x4, 8b/10b"

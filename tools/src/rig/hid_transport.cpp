@@ -8,11 +8,34 @@
 #include <cerrno>
 #include <string>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 
 namespace trm::rig {
 namespace {
 
 bool contains(const std::string& text, const char* what) { return text.find(what) != std::string::npos; }
+
+// hidapi's hidraw backend looks the node up in udev by its device number and does not survive a path that is not a
+// hidraw character device (a regular file, /dev/zero): refuse such a path before handing it over.
+void require_hidraw_node(const std::string& path) {
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT)
+      throw RigError(RigErrorKind::NoDevice, "no HID device at " + path + " (it does not exist); 'trm feed --list' shows what is connected");
+    return;  // unreadable metadata: let hidapi report why it cannot open the node
+  }
+  const auto refuse = [&](const std::string& what) {
+    throw RigError(RigErrorKind::NoDevice, "--hid " + path + " is " + what +
+                                               ", not a hidraw device node (/dev/hidrawN); 'trm feed --list' shows what is connected");
+  };
+  if (!S_ISCHR(st.st_mode)) refuse(S_ISDIR(st.st_mode) ? "a directory" : S_ISREG(st.st_mode) ? "a regular file" : "not a character device");
+  const std::string sys = "/sys/dev/char/" + std::to_string(major(st.st_rdev)) + ":" + std::to_string(minor(st.st_rdev));
+  char subsystem[4096];
+  const ssize_t n = ::readlink((sys + "/subsystem").c_str(), subsystem, sizeof subsystem - 1);
+  if (n <= 0) refuse("a character device unknown to sysfs");
+  const std::string target(subsystem, static_cast<std::size_t>(n));
+  if (!target.ends_with("/hidraw")) refuse("a character device of the '" + target.substr(target.rfind('/') + 1) + "' subsystem");
+}
 
 struct Enumeration {
   const HidApi* api;
@@ -64,6 +87,7 @@ void HidTransport::open_device() {
   }
   opened_path_ = path;
   if (options_.id) opened_id_ = *options_.id;
+  if (!options_.path.empty() && api_->backend == "hidraw") require_hidraw_node(path);
 
   device_ = api_->open_path(path.c_str());
   if (!device_) {

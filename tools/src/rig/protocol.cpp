@@ -61,9 +61,10 @@ void RigFrame::validate() const {
 
 RigFrame crop_and_decimate(const RigFrame& view, const Region& region, int step) {
   if (step < 1) throw std::invalid_argument("downscale step must be >= 1");
-  if (region.width <= 0 || region.height <= 0 || region.x < 0 || region.y < 0 ||
-      region.x + region.width > view.width || region.y + region.height > view.height)
-    throw std::invalid_argument("region " + std::to_string(region.x) + "," + std::to_string(region.y) + "," +
+  // Compared by subtraction: x + width can exceed INT_MAX.
+  if (region.width <= 0 || region.height <= 0 || region.x < 0 || region.y < 0 || region.width > view.width ||
+      region.height > view.height || region.x > view.width - region.width || region.y > view.height - region.height)
+    throw std::invalid_argument("--roi " + std::to_string(region.x) + "," + std::to_string(region.y) + "," +
                                 std::to_string(region.width) + "," + std::to_string(region.height) +
                                 " does not lie inside the " + std::to_string(view.width) + "x" +
                                 std::to_string(view.height) + " view");
