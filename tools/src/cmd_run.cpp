@@ -11,7 +11,9 @@
 
 #include <chrono>
 #include <iostream>
+#include <functional>
 #include <memory>
+#include <optional>
 
 namespace trm::cli {
 
@@ -64,6 +66,10 @@ void register_run(CLI::App& app, Action& action) {
       if (run_options.link_enabled() && run_options.capture_out.empty()) {
         run_options.capture_out = dir.file("link.trmcap").string();  // moves into place with the rest
       }
+      std::optional<LinkRecorder> link_recorder;
+      if (run_options.link_enabled()) link_recorder.emplace(dir, *options);
+      std::function<void(const link::LinkFrameUsage&)> link_sink;
+      if (link_recorder) link_sink = [&](const link::LinkFrameUsage& usage) { link_recorder->add(usage); };
       const PipelineResult result = run_pipeline(run_options, [&](const DecodedView& view) {
         const cv::Mat perceived = recorder.add(view);
         const FrameMeta& meta = view.sent->meta;
@@ -82,14 +88,14 @@ void register_run(CLI::App& app, Action& action) {
           }
         }
         progress.update(++done);
-      });
+      }, link_sink);
       progress.finish();
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       Json report = recorder.report(wall);
       std::string link_lines;
       if (result.hardware) report["hardware"] = hardware_json(*result.hardware);
       if (result.link) {
-        report["link"] = write_link_outputs(dir, *options, *result.link, recorder.full_width(), recorder.full_height());
+        report["link"] = link_recorder->finish(*result.link, recorder.full_width(), recorder.full_height());
         link_lines = link_summary_lines(*result.link);
       }
       dir.write_text("report.json", report.dump(2) + "\n");

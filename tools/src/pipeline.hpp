@@ -85,8 +85,7 @@ struct DecodedView {
 cv::Size parse_view_size(const std::string& text, const std::string& option = "--size");
 
 struct LinkOutcome {
-  std::vector<link::LinkFrameUsage> frames;
-  link::BandwidthSummary summary;
+  link::BandwidthSummary summary;  // per-frame usage goes to run_pipeline's link_sink as it happens
   link::ReceiverCounters receiver;
   link::FaultCounters faults;
   link::LinkBudget budget;
@@ -113,7 +112,9 @@ CaptureDecodeResult decode_capture_stream(
     const PipelineOptions& options, const std::string& capture_path,
     const std::function<void(const link::ReceivedFrame& received, const DecodedFrame& decoded)>& sink);
 
-// Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order.
-PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink);
+// Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order and,
+// when the link is simulated, link_sink for each link frame once it has been carried.
+PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink,
+                            const std::function<void(const link::LinkFrameUsage&)>& link_sink = {});
 
 }  // namespace trm::cli
