@@ -40,7 +40,9 @@ double tick_step(double span, int target) {
 }  // namespace
 
 PlotTrace::PlotTrace(std::string label, std::size_t max_buckets) : label_(std::move(label)), max_buckets_(max_buckets) {
-  if (max_buckets_ < 2 || max_buckets_ % 2 != 0) throw std::invalid_argument("plot trace: max_buckets must be even, >= 2");
+  if (max_buckets_ < 2 || max_buckets_ % 2 != 0) {
+    throw std::invalid_argument("plot trace: max_buckets must be even, >= 2");
+  }
   buckets_.reserve(max_buckets_);
 }
 
@@ -74,8 +76,9 @@ void plot_bits_per_frame(const std::filesystem::path& path, std::span<const Plot
                          const std::string& title) {
   std::vector<PlotTrace> traces;
   for (const PlotSeries& s : series) {
-    // Enough buckets for one value each: the plot of the whole series.
-    PlotTrace& trace = traces.emplace_back(s.label, std::max<std::size_t>(2, s.bits_per_frame.size() + 1) & ~std::size_t{1});
+    // One bucket per value (an even count, at least 2): the plot of the whole series.
+    const std::size_t buckets = std::max<std::size_t>(2, (s.bits_per_frame.size() + 1) / 2 * 2);
+    PlotTrace& trace = traces.emplace_back(s.label, buckets);
     for (double v : s.bits_per_frame) trace.add(v);
   }
   plot_bits_per_frame(path, std::span<const PlotTrace>(traces), capacity_bits, title);
@@ -139,9 +142,10 @@ void plot_bits_per_frame(const std::filesystem::path& path, std::span<const Plot
         const double x = 0.5 * static_cast<double>(start + end);
         cv::line(canvas, to_px(x, b[k].min), to_px(x, b[k].max), colour, 2, cv::LINE_AA);
       }
-      if (k + 1 < b.size() && std::isfinite(b[k].last) && std::isfinite(b[k + 1].first))
-        cv::line(canvas, to_px(static_cast<double>(end), b[k].last), to_px(static_cast<double>(end + 1), b[k + 1].first),
-                 colour, 2, cv::LINE_AA);
+      if (k + 1 < b.size() && std::isfinite(b[k].last) && std::isfinite(b[k + 1].first)) {
+        const auto x = static_cast<double>(end);
+        cv::line(canvas, to_px(x, b[k].last), to_px(x + 1.0, b[k + 1].first), colour, 2, cv::LINE_AA);
+      }
     }
     if (count == 1 && std::isfinite(b[0].first)) cv::circle(canvas, to_px(0, b[0].first), 3, colour, cv::FILLED);
   }
