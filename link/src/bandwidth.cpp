@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
-#include <sstream>
 #include <stdexcept>
+#include <system_error>
 
 namespace trm::link {
 
@@ -46,31 +46,29 @@ const LinkFrameUsage& BandwidthMeter::add(std::int64_t index, const std::string&
   u.available_seconds = budget_.available_seconds();
   u.utilisation = u.wire_seconds / u.available_seconds;
   u.fits = u.wire_seconds <= u.available_seconds;
-  frames_.push_back(std::move(u));
-  return frames_.back();
+  BandwidthSummary& s = running_;
+  ++s.link_frames;
+  s.peak_wire_bits = std::max(s.peak_wire_bits, bits.wire_bits());
+  s.peak_payload_bits = std::max(s.peak_payload_bits, bits.payload_bits);
+  s.peak_utilisation = std::max(s.peak_utilisation, u.utilisation);
+  s.total_pixel_bits += bits.pixel_bits;
+  s.total_payload_bits += bits.payload_bits;
+  s.total_overhead_bits += bits.overhead_bits;
+  wire_sum_ += static_cast<double>(bits.wire_bits());
+  payload_sum_ += static_cast<double>(bits.payload_bits);
+  utilisation_sum_ += u.utilisation;
+  if (!u.fits) ++s.frames_not_fitting;
+  last_ = std::move(u);
+  return last_;
 }
 
 BandwidthSummary BandwidthMeter::summary() const {
-  BandwidthSummary s;
-  s.link_frames = static_cast<std::int64_t>(frames_.size());
-  double wire_sum = 0.0, payload_sum = 0.0, utilisation_sum = 0.0;
-  for (const LinkFrameUsage& u : frames_) {
-    s.peak_wire_bits = std::max(s.peak_wire_bits, u.bits.wire_bits());
-    s.peak_payload_bits = std::max(s.peak_payload_bits, u.bits.payload_bits);
-    s.peak_utilisation = std::max(s.peak_utilisation, u.utilisation);
-    s.total_pixel_bits += u.bits.pixel_bits;
-    s.total_payload_bits += u.bits.payload_bits;
-    s.total_overhead_bits += u.bits.overhead_bits;
-    wire_sum += static_cast<double>(u.bits.wire_bits());
-    payload_sum += static_cast<double>(u.bits.payload_bits);
-    utilisation_sum += u.utilisation;
-    if (!u.fits) ++s.frames_not_fitting;
-  }
-  if (!frames_.empty()) {
-    const double n = static_cast<double>(frames_.size());
-    s.average_wire_bits = wire_sum / n;
-    s.average_payload_bits = payload_sum / n;
-    s.average_utilisation = utilisation_sum / n;
+  BandwidthSummary s = running_;
+  if (s.link_frames > 0) {
+    const double n = static_cast<double>(s.link_frames);
+    s.average_wire_bits = wire_sum_ / n;
+    s.average_payload_bits = payload_sum_ / n;
+    s.average_utilisation = utilisation_sum_ / n;
   }
   s.fits = s.frames_not_fitting == 0;
   s.required_data_gbps = static_cast<double>(s.peak_wire_bits) / budget_.available_seconds() / 1e9;
@@ -87,19 +85,54 @@ std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double
   return std::nullopt;
 }
 
-void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz) {
-  std::ostringstream out;
-  out << "link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,"
-         "wire_time_s,available_time_s,utilisation,fits\n";
-  out << std::setprecision(9);
-  for (const LinkFrameUsage& u : frames) {
-    out << u.index << ',' << static_cast<double>(u.index) / refresh_hz << ',' << u.views << ',' << u.parities << ','
-        << u.bits.pixel_bits << ',' << u.bits.payload_bits << ',' << u.bits.overhead_bits << ','
-        << u.bits.wire_bits() << ',' << u.bits.packets << ',' << u.wire_seconds << ',' << u.available_seconds << ','
-        << u.utilisation << ',' << (u.fits ? 1 : 0) << '\n';
+FramesCsvWriter::FramesCsvWriter(const std::filesystem::path& path, double refresh_hz)
+    : path_(path), temp_(detail::temporary_sibling(path)), refresh_hz_(refresh_hz) {
+  out_.open(temp_, std::ios::binary | std::ios::trunc);
+  out_ << "link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,"
+          "wire_time_s,available_time_s,utilisation,fits\n";
+  out_ << std::setprecision(9);
+  if (!out_) {
+    std::error_code ignored;
+    std::filesystem::remove(temp_, ignored);
+    throw std::runtime_error("cannot write '" + path_.string() + "'");
   }
-  const std::string text = out.str();
-  detail::write_file_atomically(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+FramesCsvWriter::~FramesCsvWriter() {
+  if (closed_) return;
+  out_.close();
+  std::error_code ignored;
+  std::filesystem::remove(temp_, ignored);
+}
+
+void FramesCsvWriter::add(const LinkFrameUsage& u) {
+  out_ << u.index << ',' << static_cast<double>(u.index) / refresh_hz_ << ',' << u.views << ',' << u.parities << ','
+       << u.bits.pixel_bits << ',' << u.bits.payload_bits << ',' << u.bits.overhead_bits << ',' << u.bits.wire_bits()
+       << ',' << u.bits.packets << ',' << u.wire_seconds << ',' << u.available_seconds << ',' << u.utilisation << ','
+       << (u.fits ? 1 : 0) << '\n';
+}
+
+void FramesCsvWriter::close() {
+  if (closed_) return;
+  out_.close();
+  std::error_code ec;
+  if (!out_) {
+    std::filesystem::remove(temp_, ec);
+    throw std::runtime_error("cannot write '" + path_.string() + "'");
+  }
+  std::filesystem::rename(temp_, path_, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temp_, ignored);
+    throw std::runtime_error("cannot rename temporary file onto '" + path_.string() + "': " + ec.message());
+  }
+  closed_ = true;
+}
+
+void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz) {
+  FramesCsvWriter writer(path, refresh_hz);
+  for (const LinkFrameUsage& u : frames) writer.add(u);
+  writer.close();
 }
 
 }  // namespace trm::link

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace trm::link {
@@ -44,14 +45,59 @@ double tick_step(double span, int target) {
 
 }  // namespace
 
+PlotTrace::PlotTrace(std::string label, std::size_t max_buckets) : label_(std::move(label)), max_buckets_(max_buckets) {
+  if (max_buckets_ < 2 || max_buckets_ % 2 != 0) {
+    throw std::invalid_argument("plot trace: max_buckets must be even, >= 2");
+  }
+  buckets_.reserve(max_buckets_);
+}
+
+void PlotTrace::add(double bits) {
+  const bool finite = std::isfinite(bits);
+  if (count_ % width_ == 0) {
+    if (buckets_.size() == max_buckets_) {
+      // Full: pairs of buckets become one of twice the width, which leaves count_ on a bucket boundary.
+      for (std::size_t i = 0; i < max_buckets_ / 2; ++i) {
+        const Bucket& a = buckets_[2 * i];
+        const Bucket& b = buckets_[2 * i + 1];
+        buckets_[i] = {a.first, b.last, std::min(a.min, b.min), std::max(a.max, b.max)};
+      }
+      buckets_.resize(max_buckets_ / 2);
+      width_ *= 2;
+    }
+    const double inf = std::numeric_limits<double>::infinity();
+    buckets_.push_back({bits, bits, finite ? bits : inf, finite ? bits : -inf});
+  } else {
+    Bucket& b = buckets_.back();
+    b.last = bits;
+    if (finite) {
+      b.min = std::min(b.min, bits);
+      b.max = std::max(b.max, bits);
+    }
+  }
+  ++count_;
+}
+
 void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotSeries> series, double capacity_bits,
                          const std::string& title) {
-  std::size_t frames = 0;
-  double y_max = capacity_bits > 0.0 ? capacity_bits : 0.0;
+  std::vector<PlotTrace> traces;
   for (const PlotSeries& s : series) {
-    frames = std::max(frames, s.bits_per_frame.size());
-    for (double v : s.bits_per_frame)
-      if (std::isfinite(v)) y_max = std::max(y_max, v);
+    // One bucket per value (an even count, at least 2): the plot of the whole series.
+    const std::size_t buckets = std::max<std::size_t>(2, (s.bits_per_frame.size() + 1) / 2 * 2);
+    PlotTrace& trace = traces.emplace_back(s.label, buckets);
+    for (double v : s.bits_per_frame) trace.add(v);
+  }
+  plot_bits_per_frame(path, std::span<const PlotTrace>(traces), capacity_bits, title);
+}
+
+void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotTrace> series, double capacity_bits,
+                         const std::string& title) {
+  std::int64_t frames = 0;
+  double y_max = capacity_bits > 0.0 ? capacity_bits : 0.0;
+  for (const PlotTrace& s : series) {
+    frames = std::max(frames, s.count());
+    for (const PlotTrace::Bucket& b : s.buckets())
+      if (b.min <= b.max) y_max = std::max(y_max, b.max);
   }
   if (y_max <= 0.0) y_max = 1.0;
   y_max *= 1.1;
@@ -93,12 +139,21 @@ void plot_bits_per_frame(const std::filesystem::path& path, std::span<const Plot
   // Series, then the legend on a white box so that no line runs through it.
   for (std::size_t i = 0; i < series.size(); ++i) {
     const cv::Scalar colour = kColours[i % std::size(kColours)];
-    const std::vector<double>& v = series[i].bits_per_frame;
-    for (std::size_t x = 0; x + 1 < v.size(); ++x)
-      if (std::isfinite(v[x]) && std::isfinite(v[x + 1]))
-        cv::line(canvas, to_px(static_cast<double>(x), v[x]), to_px(static_cast<double>(x + 1), v[x + 1]), colour, 2,
-                 cv::LINE_AA);
-    if (v.size() == 1 && std::isfinite(v[0])) cv::circle(canvas, to_px(0, v[0]), 3, colour, cv::FILLED);
+    const std::vector<PlotTrace::Bucket>& b = series[i].buckets();
+    const std::int64_t w = series[i].bucket_width(), count = series[i].count();
+    for (std::size_t k = 0; k < b.size(); ++k) {
+      const auto start = static_cast<std::int64_t>(k) * w;
+      const std::int64_t end = std::min(start + w, count) - 1;  // index of the bucket's last value
+      if (w > 1 && b[k].min <= b[k].max) {
+        const double x = 0.5 * static_cast<double>(start + end);
+        cv::line(canvas, to_px(x, b[k].min), to_px(x, b[k].max), colour, 2, cv::LINE_AA);
+      }
+      if (k + 1 < b.size() && std::isfinite(b[k].last) && std::isfinite(b[k + 1].first)) {
+        const auto x = static_cast<double>(end);
+        cv::line(canvas, to_px(x, b[k].last), to_px(x + 1.0, b[k + 1].first), colour, 2, cv::LINE_AA);
+      }
+    }
+    if (count == 1 && std::isfinite(b[0].first)) cv::circle(canvas, to_px(0, b[0].first), 3, colour, cv::FILLED);
   }
   if (!series.empty()) {
     const cv::Point corner(kLeft + plot_w - 340, kTop + 8);
@@ -108,7 +163,7 @@ void plot_bits_per_frame(const std::filesystem::path& path, std::span<const Plot
     for (std::size_t i = 0; i < series.size(); ++i) {
       const cv::Point legend = corner + cv::Point(10, 15 + static_cast<int>(i) * 20);
       cv::line(canvas, legend, legend + cv::Point(25, 0), kColours[i % std::size(kColours)], 3);
-      cv::putText(canvas, series[i].label, legend + cv::Point(32, 5), font, 0.45, black, 1, cv::LINE_AA);
+      cv::putText(canvas, series[i].label(), legend + cv::Point(32, 5), font, 0.45, black, 1, cv::LINE_AA);
     }
   }
 

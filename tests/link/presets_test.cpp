@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -157,9 +158,9 @@ TEST(Bandwidth, CsvAndPlotAreWritten) {
   const std::filesystem::path dir = std::filesystem::path(TRM_BINARY_DIR) / "test_link_out";
   std::filesystem::create_directories(dir);
   BandwidthMeter meter({parse_link_preset("custom:1:1"), 100.0, std::nullopt});
-  meter.add(0, "F", ViewBits{100, 100, 20, 1}, 1);
-  meter.add(1, "R", ViewBits{50, 50, 20, 1}, 1);
-  write_frames_csv(dir / "frames.csv", meter.frames(), 100.0);
+  const std::vector<LinkFrameUsage> frames = {meter.add(0, "F", ViewBits{100, 100, 20, 1}, 1),
+                                              meter.add(1, "R", ViewBits{50, 50, 20, 1}, 1)};
+  write_frames_csv(dir / "frames.csv", frames, 100.0);
   std::ifstream in(dir / "frames.csv");
   std::stringstream text;
   text << in.rdbuf();
@@ -176,7 +177,27 @@ TEST(Bandwidth, CsvAndPlotAreWritten) {
   EXPECT_EQ(png.rows, 640);
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << "temporary file left: " << entry.path();
-  EXPECT_THROW(write_frames_csv(dir / "no_such_dir" / "frames.csv", meter.frames(), 100.0), std::runtime_error);
+  EXPECT_THROW(write_frames_csv(dir / "no_such_dir" / "frames.csv", frames, 100.0), std::runtime_error);
+}
+
+TEST(Bandwidth, PlotTraceStaysBoundedAndKeepsTheEnvelope) {
+  PlotTrace trace("long run", 8);
+  for (int i = 0; i < 100; ++i) trace.add(i == 37 ? 1000.0 : i == 50 ? std::nan("") : i);
+  EXPECT_EQ(trace.count(), 100);
+  EXPECT_EQ(trace.bucket_width(), 16);  // 8 buckets of 8 values held 64; 100 needs width 16
+  ASSERT_EQ(trace.buckets().size(), 7u);
+  EXPECT_EQ(trace.buckets().front().first, 0.0);
+  EXPECT_EQ(trace.buckets().back().last, 99.0);
+  EXPECT_EQ(trace.buckets()[2].max, 1000.0);  // values 32..47
+  EXPECT_EQ(trace.buckets()[3].min, 48.0);    // the NaN is left out of min and max
+  EXPECT_EQ(trace.buckets()[3].max, 63.0);
+
+  PlotTrace short_trace("short", 8);
+  for (double v : {100.0, 50.0, 100.0}) short_trace.add(v);
+  EXPECT_EQ(short_trace.bucket_width(), 1);
+  ASSERT_EQ(short_trace.buckets().size(), 3u);
+  EXPECT_EQ(short_trace.buckets()[1].min, 50.0);
+  EXPECT_THROW(PlotTrace("odd", 3), std::invalid_argument);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <map>
 #include <utility>
+#include <vector>
 
 namespace trm::cli {
 namespace {
@@ -17,13 +18,19 @@ struct ViewRecord {
 };
 using Records = std::map<std::pair<std::int64_t, int>, ViewRecord>;
 
-Records run(const PipelineOptions& options, PipelineResult* result = nullptr) {
+Records run(const PipelineOptions& options, PipelineResult* result = nullptr,
+            std::vector<link::LinkFrameUsage>* usage = nullptr) {
   Records records;
-  PipelineResult r = run_pipeline(options, [&](const DecodedView& view) {
-    const FrameStats& s = view.decoded->stats;
-    records[{view.sent->meta.index, view.sent->meta.eye}] = {
-        view.decoded->drive_codes.clone(), s.concealed_lines == 0 && !s.frame_lost, view.sent->meta.parity};
-  });
+  PipelineResult r = run_pipeline(
+      options,
+      [&](const DecodedView& view) {
+        const FrameStats& s = view.decoded->stats;
+        records[{view.sent->meta.index, view.sent->meta.eye}] = {
+            view.decoded->drive_codes.clone(), s.concealed_lines == 0 && !s.frame_lost, view.sent->meta.parity};
+      },
+      [&](const link::LinkFrameUsage& u) {
+        if (usage) usage->push_back(u);
+      });
   if (result) *result = std::move(r);
   return records;
 }
@@ -102,14 +109,17 @@ TEST(Link, PayloadPerPairIsExactAndStereoIsFlat) {
     options.frames = 6;
     options.link_preset = "dp1.2";
     PipelineResult result;
-    run(options, &result);
+    std::vector<link::LinkFrameUsage> usage;
+    run(options, &result, &usage);
     ASSERT_TRUE(result.link);
+    ASSERT_EQ(usage.size(), 6u);
+    EXPECT_EQ(result.link->summary.link_frames, 6);
     const int w = 49, h = 31;  // floor(0.5 * 97 + 0.5), floor(0.5 * 61 + 0.5)
     const std::uint64_t full_bits = 97ull * 61 * 3 * 8, reduced_bits = static_cast<std::uint64_t>(w) * h * 3 * 8;
-    for (const auto& frame : result.link->frames) {
+    for (const auto& frame : usage) {
       if (stereo) {
         EXPECT_EQ(frame.bits.pixel_bits, full_bits + reduced_bits);
-        EXPECT_EQ(frame.bits.wire_bits(), result.link->frames.front().bits.wire_bits());
+        EXPECT_EQ(frame.bits.wire_bits(), usage.front().bits.wire_bits());
       } else {
         EXPECT_EQ(frame.bits.pixel_bits, frame.index % 2 == 0 ? full_bits : reduced_bits);
       }

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -37,6 +38,13 @@ void write_frames(const fs::path& dir, int n, int width, int height, bool same =
     std::snprintf(name, sizeof name, "frame_%03d.png", i);
     ASSERT_TRUE(cv::imwrite((dir / name).string(), frame));
   }
+}
+
+std::vector<nlohmann::json> read_json_lines(const fs::path& path) {
+  std::vector<nlohmann::json> records;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) records.push_back(nlohmann::json::parse(line));
+  return records;
 }
 
 bool no_partial_left(const fs::path& parent) {
@@ -155,7 +163,26 @@ TEST(Cli, RunWritesReportAndPreviews) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(tmp.path() / "out" / "report.json");
   const auto report = nlohmann::json::parse(in);
-  EXPECT_EQ(report["frames"].size(), 4u);
+  EXPECT_EQ(report["summary"]["views"], 4);
+  EXPECT_EQ(report["summary"]["pairs"], 2);
+  EXPECT_EQ(report["records"]["views"], "views.jsonl");
+  EXPECT_EQ(report["records"]["pairs"], "pairs.jsonl");
+  EXPECT_FALSE(report.contains("frames"));
+  // One JSON object per line: the per-view records, then the per-pair ones.
+  const auto views = read_json_lines(tmp.path() / "out" / "views.jsonl");
+  ASSERT_EQ(views.size(), 4u);
+  for (int t = 0; t < 4; ++t) {
+    EXPECT_EQ(views[t]["t"], t);
+    EXPECT_EQ(views[t]["parity"], t % 2 == 0 ? "full" : "reduced");
+    EXPECT_EQ(views[t]["sent_size"][0], t % 2 == 0 ? 48 : 24);
+    EXPECT_TRUE(views[t].contains("vs_reference"));
+    EXPECT_TRUE(views[t].contains("fixed_point_events"));
+  }
+  const auto pairs = read_json_lines(tmp.path() / "out" / "pairs.jsonl");
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[1]["t"][0], 2);
+  EXPECT_EQ(pairs[1]["t"][1], 3);
+  EXPECT_TRUE(pairs[1].contains("psnr_db"));
   EXPECT_EQ(report["parameters"]["size"][0], 48);
   EXPECT_EQ(report["parameters"]["reduced_size"][0], 24);
   // Pixel ratio over whole pairs: (W H + w h) / (2 W H) = (48*40 + 24*20) / (2*48*40) = 0.625.

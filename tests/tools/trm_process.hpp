@@ -6,13 +6,17 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace trm::test {
 
 struct TrmResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together
+  long max_rss_kb = 0;  // run_trm_measured: peak resident set of the trm process itself
 };
 
 inline TrmResult run_trm(const std::string& args) {
@@ -23,6 +27,41 @@ inline TrmResult run_trm(const std::string& args) {
   while (fgets(buffer.data(), static_cast<int>(buffer.size()), pipe)) result.output += buffer.data();
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// Runs trm without a shell and reaps it with wait4, so that the peak RSS is that of trm alone (RUSAGE_CHILDREN
+// would be the maximum over every child the test process has ever waited for).
+inline TrmResult run_trm_measured(const std::vector<std::string>& args) {
+  TrmResult result;
+  int fds[2];
+  if (pipe(fds) != 0) return result;
+  std::vector<std::string> argv_text = {TRM_EXECUTABLE};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) return result;
+  if (pid == 0) {
+    dup2(fds[1], STDOUT_FILENO);
+    dup2(fds[1], STDERR_FILENO);
+    close(fds[0]);
+    close(fds[1]);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(fds[1]);
+  std::array<char, 4096> buffer{};
+  for (ssize_t n; (n = read(fds[0], buffer.data(), buffer.size())) > 0;) {
+    result.output.append(buffer.data(), static_cast<std::size_t>(n));
+  }
+  close(fds[0]);
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid) return result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.max_rss_kb = usage.ru_maxrss;
   return result;
 }
 

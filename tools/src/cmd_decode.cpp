@@ -58,20 +58,21 @@ void write_drive_files(const OutputDir& dir, const FrameMeta& meta, const Decode
 
 int decode_capture(const PipelineOptions& options, const std::string& capture_path, const std::string& out) {
   OutputDir dir(out);
-  Json frames = Json::array();
+  JsonLinesWriter views(dir.file("views.jsonl"));
   const CaptureDecodeResult result =
       decode_capture_stream(options, capture_path, [&](const FrameMeta& meta, const link::ReceivedFrame* received,
                                                        const DecodedFrame& decoded) {
         // A lost view is written too: it is what the panel shows (its previous output, held).
         write_drive_files(dir, meta, decoded, options.output_bits);
-        frames.push_back({{"t", meta.index},
-                          {"eye", meta.eye},
-                          {"parity", to_string(meta.parity)},
-                          {"lost", received == nullptr},
-                          {"intact_lines", received ? received->intact_lines() : 0},
-                          {"concealed_lines", decoded.stats.concealed_lines},
-                          {"clipped_fraction", decoded.stats.clipped_fraction}});
+        views.write({{"t", meta.index},
+                     {"eye", meta.eye},
+                     {"parity", to_string(meta.parity)},
+                     {"lost", received == nullptr},
+                     {"intact_lines", received ? received->intact_lines() : 0},
+                     {"concealed_lines", decoded.stats.concealed_lines},
+                     {"clipped_fraction", decoded.stats.clipped_fraction}});
       });
+  views.close();
   const link::ReceiverCounters& c = result.receiver;
   Json report;
   report["tool"] = "trm";
@@ -84,7 +85,7 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
   report["receiver"] = receiver_json(c);
   report["summary"] = {
       {"views", result.views}, {"lost_views", result.lost_views}, {"concealed_lines", result.concealed_lines}};
-  report["frames"] = frames;
+  report["records"] = {{"views", views.file_name()}};
   dir.write_text("report.json", report.dump(2) + "\n");
   dir.commit();
   std::cout << "trm decode: " << result.views << " views from " << capture_path << " -> " << dir.target().string()
@@ -121,11 +122,12 @@ void register_decode(CLI::App& app, Action& action) {
       }
       const auto start = std::chrono::steady_clock::now();
       OutputDir dir(*out);
-      RunRecorder recorder(*options);
+      RunRecorder recorder(*options, dir.staging());
       const std::int64_t frames = run_pipeline(*options, [&](const DecodedView& view) {
         recorder.add(view);
         write_drive_files(dir, view.sent->meta, *view.decoded, options->output_bits);
       }).frames;
+      recorder.close();
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       dir.write_text("report.json", recorder.report(wall).dump(2) + "\n");
       dir.commit();

@@ -1,5 +1,6 @@
 // `trm run`: the main job. Renders a scene (or reads an input), runs the GPU-side encoder and the decoder,
-// and writes report.json plus PNG previews of the first frame pair into the output directory.
+// and writes report.json, the per-view and per-pair records (views.jsonl, pairs.jsonl, streamed as they come) and
+// PNG previews of the first frame pair into the output directory.
 #include "commands.hpp"
 #include "hw_report.hpp"
 #include "link_report.hpp"
@@ -11,7 +12,9 @@
 
 #include <chrono>
 #include <iostream>
+#include <functional>
 #include <memory>
+#include <optional>
 
 namespace trm::cli {
 
@@ -52,7 +55,7 @@ void register_run(CLI::App& app, Action& action) {
       warn_refresh(options->refresh_hz);
       const auto start = std::chrono::steady_clock::now();
       OutputDir dir(*out);
-      RunRecorder recorder(*options);
+      RunRecorder recorder(*options, dir.staging());
       const std::int64_t total_views =
           (options->frames > 0 ? options->frames : options->default_frames) * (options->encoder.stereo ? 2 : 1);
       Progress progress(total_views);
@@ -64,6 +67,10 @@ void register_run(CLI::App& app, Action& action) {
       if (run_options.link_enabled() && run_options.capture_out.empty()) {
         run_options.capture_out = dir.file("link.trmcap").string();  // moves into place with the rest
       }
+      std::optional<LinkRecorder> link_recorder;
+      if (run_options.link_enabled()) link_recorder.emplace(dir, *options);
+      std::function<void(const link::LinkFrameUsage&)> link_sink;
+      if (link_recorder) link_sink = [&](const link::LinkFrameUsage& usage) { link_recorder->add(usage); };
       const PipelineResult result = run_pipeline(run_options, [&](const DecodedView& view) {
         const cv::Mat perceived = recorder.add(view);
         const FrameMeta& meta = view.sent->meta;
@@ -82,14 +89,16 @@ void register_run(CLI::App& app, Action& action) {
           }
         }
         progress.update(++done);
-      });
+      }, link_sink);
       progress.finish();
+      recorder.close();
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       Json report = recorder.report(wall);
       std::string link_lines;
       if (result.hardware) report["hardware"] = hardware_json(*result.hardware);
       if (result.link) {
-        report["link"] = write_link_outputs(dir, *options, *result.link, recorder.full_width(), recorder.full_height());
+        report["link"] = link_recorder->finish(*result.link, recorder.full_width(), recorder.full_height());
+        report["records"]["link_frames"] = "frames.csv";
         link_lines = link_summary_lines(*result.link);
       }
       dir.write_text("report.json", report.dump(2) + "\n");

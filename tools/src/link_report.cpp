@@ -9,15 +9,15 @@ namespace trm::cli {
 namespace {
 
 // Wire bits per link frame that a configuration would need, predicted from the frame geometry alone
-// (raw coding): the comparison series of the plot.
-std::vector<double> predicted_series(const PipelineOptions& options, const link::PacketizerConfig& packetizer,
-                                     std::int64_t frames, int full_width, int full_height, bool stereo, bool trm) {
+// (raw coding): a comparison series of the plot.
+link::PlotTrace predicted_trace(std::string label, const PipelineOptions& options,
+                                const link::PacketizerConfig& packetizer, std::int64_t frames, int full_width,
+                                int full_height, bool stereo, bool trm) {
   EncoderConfig config = options.encoder;
   config.stereo = stereo;
   const int reduced_width = reduced_size(full_width, config.reduction);
   const int reduced_height = reduced_size(full_height, config.reduction);
-  std::vector<double> bits;
-  bits.reserve(static_cast<std::size_t>(frames));
+  link::PlotTrace trace(std::move(label));
   for (std::int64_t t = 0; t < frames; ++t) {
     double total = 0;
     for (int eye = 0; eye < (stereo ? 2 : 1); ++eye) {
@@ -33,30 +33,38 @@ std::vector<double> predicted_series(const PipelineOptions& options, const link:
       meta.transfer = config.transfer;
       total += static_cast<double>(link::predict_raw_view_bits(meta, packetizer).wire_bits());
     }
-    bits.push_back(total);
+    trace.add(total);
   }
-  return bits;
+  return trace;
 }
 
 }  // namespace
 
-Json write_link_outputs(const OutputDir& dir, const PipelineOptions& options, const LinkOutcome& outcome,
-                        int full_width, int full_height) {
-  link::write_frames_csv(dir.file("frames.csv"), outcome.frames, options.refresh_hz);
+LinkRecorder::LinkRecorder(const OutputDir& dir, const PipelineOptions& options)
+    : dir_(dir),
+      options_(options),
+      csv_(dir.file("frames.csv"), options.refresh_hz),
+      measured_(std::string("TRM ") + (options.encoder.stereo ? "stereo off-phase" : "mono") + " (this run)") {}
 
-  std::vector<link::PlotSeries> series;
-  std::vector<double> measured;
-  for (const auto& f : outcome.frames) measured.push_back(static_cast<double>(f.bits.wire_bits()));
-  const bool stereo = options.encoder.stereo;
-  series.push_back({std::string("TRM ") + (stereo ? "stereo off-phase" : "mono") + " (this run)", measured});
-  const auto frames = static_cast<std::int64_t>(outcome.frames.size());
-  link::PacketizerConfig raw = options.link_config(full_width, full_height).packetizer;
+void LinkRecorder::add(const link::LinkFrameUsage& usage) {
+  csv_.add(usage);
+  measured_.add(static_cast<double>(usage.bits.wire_bits()));
+}
+
+Json LinkRecorder::finish(const LinkOutcome& outcome, int full_width, int full_height) {
+  csv_.close();
+  const bool stereo = options_.encoder.stereo;
+  const std::int64_t frames = measured_.count();
+  link::PacketizerConfig raw = options_.link_config(full_width, full_height).packetizer;
   raw.coding = link::PayloadCoding::Raw;
-  series.push_back({std::string("full rate ") + (stereo ? "stereo" : "mono"),
-                    predicted_series(options, raw, frames, full_width, full_height, stereo, false)});
-  series.push_back({std::string("TRM ") + (stereo ? "mono" : "stereo off-phase") + " (raw, predicted)",
-                    predicted_series(options, raw, frames, full_width, full_height, !stereo, true)});
-  link::plot_bits_per_frame(dir.file("link_bits.png"), series, outcome.budget.capacity_bits_per_frame(),
+  const std::vector<link::PlotTrace> series = {
+      measured_,
+      predicted_trace(std::string("full rate ") + (stereo ? "stereo" : "mono"), options_, raw, frames, full_width,
+                      full_height, stereo, false),
+      predicted_trace(std::string("TRM ") + (stereo ? "mono" : "stereo off-phase") + " (raw, predicted)", options_, raw,
+                      frames, full_width, full_height, !stereo, true)};
+  link::plot_bits_per_frame(dir_.file("link_bits.png"), std::span<const link::PlotTrace>(series),
+                            outcome.budget.capacity_bits_per_frame(),
                             "wire bits per link frame on " + outcome.budget.preset.name);
 
   const link::BandwidthSummary& s = outcome.summary;

@@ -10,9 +10,21 @@
 
 namespace trm::cli {
 
-// Writes frames.csv and link_bits.png into dir; returns the report.json "link" block.
-Json write_link_outputs(const OutputDir& dir, const PipelineOptions& options, const LinkOutcome& outcome,
-                        int full_width, int full_height);
+// Streams frames.csv (a row per link frame as it is carried) and keeps the plot's trace of this run bounded, so
+// that a long run's memory stays flat.
+class LinkRecorder {
+ public:
+  LinkRecorder(const OutputDir& dir, const PipelineOptions& options);
+  void add(const link::LinkFrameUsage& usage);
+  // Closes frames.csv, draws link_bits.png; returns the report.json "link" block.
+  Json finish(const LinkOutcome& outcome, int full_width, int full_height);
+
+ private:
+  const OutputDir& dir_;
+  const PipelineOptions& options_;
+  link::FramesCsvWriter csv_;
+  link::PlotTrace measured_;
+};
 std::string link_summary_lines(const LinkOutcome& outcome);
 // The receiver's counters as report.json holds them (run --link and decode --capture).
 Json receiver_json(const link::ReceiverCounters& counters);

@@ -305,7 +305,8 @@ void PipelineOptions::validate() const {
   }
 }
 
-PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink) {
+PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink,
+                            const std::function<void(const link::LinkFrameUsage&)>& link_sink) {
   options.validate();
   const std::unique_ptr<FrameSource> source = options.open_source();
   require_memory_for(options, cv::Size(source->width(), source->height()));
@@ -384,7 +385,10 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       encode_seconds[static_cast<std::size_t>(eye)] = seconds_since(start);
     }
     std::vector<link::ReceivedFrame> received;
-    if (simulation) received = simulation->carry(t, sent);
+    if (simulation) {
+      received = simulation->carry(t, sent);
+      if (link_sink) link_sink(simulation->meter().last());
+    }
     for (int eye = 0; eye < eyes; ++eye) {
       const LinkFrame& view_sent = sent[static_cast<std::size_t>(eye)];
       const auto start = std::chrono::steady_clock::now();
@@ -445,7 +449,6 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   if (streaming) result.hardware = streaming->report(cv::Size(source->width(), source->height()));
   if (simulation) {
     simulation->finish();
-    result.link->frames = simulation->meter().frames();
     result.link->summary = simulation->meter().summary();
     result.link->receiver = simulation->receiver_counters();
     result.link->faults = simulation->fault_counters();

@@ -95,8 +95,7 @@ std::vector<int> parse_int_list(const std::string& text, std::size_t count, cons
                                 const std::string& expected, char separator = ',');
 
 struct LinkOutcome {
-  std::vector<link::LinkFrameUsage> frames;
-  link::BandwidthSummary summary;
+  link::BandwidthSummary summary;  // per-frame usage goes to run_pipeline's link_sink as it happens
   link::ReceiverCounters receiver;
   link::FaultCounters faults;
   link::LinkBudget budget;
@@ -126,7 +125,9 @@ using CaptureSink =
 CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const std::string& capture_path,
                                           const CaptureSink& sink);
 
-// Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order.
-PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink);
+// Runs source -> encoder -> [link] -> decoder for every frame and eye, calling sink for each view in order and,
+// when the link is simulated, link_sink for each link frame once it has been carried.
+PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink,
+                            const std::function<void(const link::LinkFrameUsage&)>& link_sink = {});
 
 }  // namespace trm::cli

@@ -11,6 +11,7 @@
 #include <iostream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 namespace trm::cli {
 
@@ -88,7 +89,27 @@ double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b) {
   return 10.0 * std::log10(1.0 / mse);
 }
 
-RunRecorder::RunRecorder(const PipelineOptions& options) : options_(options), panel_(parse_panel(options.panel)) {}
+JsonLinesWriter::JsonLinesWriter(const std::filesystem::path& path) : path_(path), out_(path, std::ios::binary) {
+  if (!out_) throw std::runtime_error("cannot write '" + path_.string() + "'");
+}
+
+void JsonLinesWriter::write(const Json& record) { out_ << record.dump() << '\n'; }
+
+void JsonLinesWriter::close() {
+  out_.close();
+  if (!out_) throw std::runtime_error("cannot write '" + path_.string() + "'");
+}
+
+RunRecorder::RunRecorder(const PipelineOptions& options, const std::filesystem::path& directory)
+    : options_(options),
+      panel_(parse_panel(options.panel)),
+      view_records_(directory / "views.jsonl"),
+      pair_records_(directory / "pairs.jsonl") {}
+
+void RunRecorder::close() {
+  view_records_.close();
+  pair_records_.close();
+}
 
 cv::Mat RunRecorder::add(const DecodedView& view) {
   const DecodedFrame& d = *view.decoded;
@@ -154,7 +175,8 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   }
   rec["seconds"] = {{"render", view.render_seconds}, {"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
   sum_render_ += view.render_seconds;
-  frames_.push_back(std::move(rec));
+  view_records_.write(rec);
+  ++views_;
 
   const cv::Mat reference = full_rate_emission(*view.linear_full, panel_, options_.output_bits);
   EyeHistory& eye = eyes_[meta.eye];
@@ -171,7 +193,8 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     pair["eye"] = meta.eye;
     pair["psnr_db"] = json_number(psnr);
     pair["max_abs_linear"] = max_abs;
-    pairs_.push_back(std::move(pair));
+    pair_records_.write(pair);
+    ++pairs_;
     if (std::isfinite(psnr)) {
       sum_psnr_ += psnr;
       min_psnr_ = std::min(min_psnr_, psnr);
@@ -210,13 +233,13 @@ Json RunRecorder::report(double wall_seconds) const {
   r["parameters"] = p;
 
   Json s;
-  const auto n = static_cast<double>(frames_.size());
-  s["views"] = frames_.size();
+  const auto n = static_cast<double>(views_);
+  s["views"] = views_;
   s["pixel_ratio"] = sum_full_payload_ > 0 ? sum_payload_ / sum_full_payload_ : 0.0;
   s["payload_bytes_total"] = sum_payload_;
   s["mean_clipped_fraction_full"] = full_views_ ? sum_clipped_full_ / static_cast<double>(full_views_) : 0.0;
   s["max_residual_abs"] = max_residual_;
-  s["pairs"] = pairs_.size();
+  s["pairs"] = pairs_;
   s["pairs_exact"] = exact_pairs_;
   s["mean_psnr_db"] = finite_psnr_pairs_ ? json_number(sum_psnr_ / static_cast<double>(finite_psnr_pairs_)) : Json(nullptr);
   s["min_psnr_db"] = finite_psnr_pairs_ ? json_number(min_psnr_) : Json(nullptr);
@@ -240,8 +263,7 @@ Json RunRecorder::report(double wall_seconds) const {
                        {"decode", n > 0 ? sum_decode_ / n : 0.0}};
   s["wall_seconds"] = wall_seconds;
   r["summary"] = s;
-  r["pairs"] = pairs_;
-  r["frames"] = frames_;
+  r["records"] = {{"views", view_records_.file_name()}, {"pairs", pair_records_.file_name()}};
   return r;
 }
 
@@ -258,7 +280,7 @@ std::string RunRecorder::summary_table() const {
     std::snprintf(b, sizeof b, f, v);
     return std::string(b);
   };
-  row("views decoded", std::to_string(frames_.size()));
+  row("views decoded", std::to_string(views_));
   row("full / reduced size", std::to_string(full_width_) + "x" + std::to_string(full_height_) + " / " +
                                  std::to_string(reduced_width_) + "x" + std::to_string(reduced_height_));
   row("link payload vs full rate", fmt("%.4f", s["pixel_ratio"].get<double>()));

@@ -1,11 +1,13 @@
-// Collects per-frame records and per-pair perception figures from the pipeline into report.json,
-// and renders the human-readable summary table.
+// Streams per-view records and per-pair perception figures from the pipeline to JSON Lines files, keeps running
+// statistics for report.json's summary, and renders the human-readable summary table.
 #pragma once
 
 #include "pipeline.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 
@@ -19,9 +21,23 @@ cv::Mat preview_8bit(const cv::Mat& linear_rgb);
 // Link payload of one view in bytes: width x height x 3 channels x bits, packed.
 std::int64_t payload_bytes(const FrameMeta& meta);
 
+// One JSON object per line, written as it comes: a long run's records live on disk, not in memory.
+class JsonLinesWriter {
+ public:
+  explicit JsonLinesWriter(const std::filesystem::path& path);  // throws std::runtime_error naming the path
+  void write(const Json& record);
+  void close();  // flushes; throws on an I/O failure
+  std::string file_name() const { return path_.filename().string(); }
+
+ private:
+  std::filesystem::path path_;
+  std::ofstream out_;
+};
+
 class RunRecorder {
  public:
-  explicit RunRecorder(const PipelineOptions& options);
+  // Per-view records go to views.jsonl and per-pair records to pairs.jsonl in `directory`.
+  RunRecorder(const PipelineOptions& options, const std::filesystem::path& directory);
   // Records one decoded view; returns the perceived pair (linear) when this view completes a pair
   // (frames 2k and 2k + 1 of one eye), else an empty Mat.
   cv::Mat add(const DecodedView& view);
@@ -29,9 +45,12 @@ class RunRecorder {
   // frame at full resolution, through the same drive quantisation.
   const cv::Mat& last_reference_pair() const { return last_reference_pair_; }
 
+  // Closes the record files (call before report()).
+  void close();
+  // Parameters, summary and "records": the names of the record files.
   Json report(double wall_seconds) const;
   std::string summary_table() const;
-  std::int64_t views() const { return static_cast<std::int64_t>(frames_.size()); }
+  std::int64_t views() const { return views_; }
   int full_width() const { return full_width_; }
   int full_height() const { return full_height_; }
 
@@ -43,8 +62,9 @@ class RunRecorder {
   };
   PipelineOptions options_;
   Panel panel_;
-  Json frames_ = Json::array();
-  Json pairs_ = Json::array();
+  JsonLinesWriter view_records_;
+  JsonLinesWriter pair_records_;
+  std::int64_t views_ = 0, pairs_ = 0;
   std::map<int, EyeHistory> eyes_;
   cv::Mat last_reference_pair_;
   int full_width_ = 0, full_height_ = 0, reduced_width_ = 0, reduced_height_ = 0;

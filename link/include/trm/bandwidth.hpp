@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <span>
 #include <string>
@@ -56,6 +57,8 @@ struct BandwidthSummary {
   std::optional<LinkPreset> minimum_preset;
 };
 
+// Keeps running statistics only, so that its memory does not grow with the run; each frame's usage (what
+// add() returns) is streamed by the caller, e.g. into a FramesCsvWriter.
 class BandwidthMeter {
  public:
   explicit BandwidthMeter(LinkBudget budget);
@@ -66,12 +69,14 @@ class BandwidthMeter {
   // The same from bit counts alone (e.g. predicted full-rate views).
   const LinkFrameUsage& add(std::int64_t index, const std::string& parities, const ViewBits& bits, int views);
 
-  const std::vector<LinkFrameUsage>& frames() const { return frames_; }
+  const LinkFrameUsage& last() const { return last_; }  // the most recently added link frame
   BandwidthSummary summary() const;
 
  private:
   LinkBudget budget_;
-  std::vector<LinkFrameUsage> frames_;
+  LinkFrameUsage last_;
+  BandwidthSummary running_;  // counts, peaks and totals; summary() adds the averages
+  double wire_sum_ = 0.0, payload_sum_ = 0.0, utilisation_sum_ = 0.0;
 };
 
 // The slowest built-in preset on which `wire_bits` fit in one frame period (less blanking, if given).
@@ -81,8 +86,24 @@ std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double
 // OUT/frames.csv: one row per link frame. Columns:
 // link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,
 // wire_time_s,available_time_s,utilisation,fits
-// Written to a temporary name in the same directory and renamed, so a reader never sees half a file.
-// Throws std::runtime_error naming the path on an I/O failure.
+// Rows are streamed to a temporary name in the same directory and renamed on close(), so a reader never
+// sees half a file. Throws std::runtime_error naming the path on an I/O failure; a writer destroyed
+// unclosed removes its temporary file.
+class FramesCsvWriter {
+ public:
+  FramesCsvWriter(const std::filesystem::path& path, double refresh_hz);
+  ~FramesCsvWriter();
+  FramesCsvWriter(const FramesCsvWriter&) = delete;
+  FramesCsvWriter& operator=(const FramesCsvWriter&) = delete;
+  void add(const LinkFrameUsage& usage);
+  void close();
+
+ private:
+  std::filesystem::path path_, temp_;
+  double refresh_hz_;
+  std::ofstream out_;
+  bool closed_ = false;
+};
 void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz);
 
 struct PlotSeries {
@@ -90,10 +111,37 @@ struct PlotSeries {
   std::vector<double> bits_per_frame;  // one value per link frame
 };
 
+// A plotted series of any length in bounded memory: consecutive values are folded into at most max_buckets
+// buckets of a power-of-two width. Up to max_buckets values each bucket holds one value and the plot is
+// exactly that of the whole series; beyond, a bucket is well under a pixel column wide and its min..max span
+// draws what the whole series would.
+class PlotTrace {
+ public:
+  struct Bucket {
+    double first, last;
+    double min, max;  // over the finite values; min > max when there are none
+  };
+  explicit PlotTrace(std::string label, std::size_t max_buckets = 4096);  // max_buckets: even, >= 2
+  void add(double bits);
+
+  const std::string& label() const { return label_; }
+  std::int64_t count() const { return count_; }
+  std::int64_t bucket_width() const { return width_; }
+  const std::vector<Bucket>& buckets() const { return buckets_; }
+
+ private:
+  std::string label_;
+  std::size_t max_buckets_;
+  std::int64_t count_ = 0, width_ = 1;
+  std::vector<Bucket> buckets_;
+};
+
 // Line plot of bits per link frame over link frame index, one coloured line per series, with a legend
 // and, when capacity_bits > 0, a dashed horizontal line for the link's capacity per frame. PNG, written
 // to a temporary name and renamed. Throws std::runtime_error on an encode or I/O failure.
-void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotSeries> series,
-                         double capacity_bits, const std::string& title);
+void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotTrace> series, double capacity_bits,
+                         const std::string& title);
+void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotSeries> series, double capacity_bits,
+                         const std::string& title);
 
 }  // namespace trm::link
