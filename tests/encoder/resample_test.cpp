@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -270,22 +269,6 @@ TEST(Downsample, RejectsBadArguments) {
   img.convertTo(f32, CV_32F);
   EXPECT_THROW(downsample(f32, 4, 4, 2.5), std::invalid_argument);
   EXPECT_THROW(upsample(img, 4, 4), std::invalid_argument);
-}
-
-TEST(Resample, FullHdViewIsFastEnough) {
-  const cv::Mat full = random_image(1080, 1200, 3, 2);
-  const auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat reduced = downsample(full, 540, 600, 2.5);
-  const auto t1 = std::chrono::steady_clock::now();
-  const cv::Mat up = upsample(reduced, 1080, 1200);
-  const auto t2 = std::chrono::steady_clock::now();
-  const double d_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  const double u_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
-  std::printf("1080x1200x3 at r=1/2: D %.1f ms, U %.1f ms\n", d_ms, u_ms);
-  EXPECT_EQ(up.size(), full.size());
-#if defined(NDEBUG) && !defined(__SANITIZE_ADDRESS__)
-  EXPECT_LT(d_ms, 500.0);  // generous: shared CI cores; typical is far lower
-#endif
 }
 
 }  // namespace

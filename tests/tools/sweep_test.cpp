@@ -93,7 +93,7 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
   std::map<std::string, std::size_t> values_of;
   for (const auto& knob : trm::cli::sweep_knobs()) {
     const fs::path plot = out / ("sweep_" + knob.name + ".png");
-    if (!knob.oled) {
+    if (!knob.oled || knob.linear_space_only) {  // this sweep is OLED in the encoded resample space
       EXPECT_FALSE(fs::exists(plot)) << knob.name;
       continue;
     }
@@ -252,7 +252,6 @@ TEST(Sweep, BadKnobsFailClearlyWithoutOutput) {
       {[](auto& o) { o.knobs = {"residual_bits", "exp_entries"}, o.values = {8, 9}; }, "exactly one --knob"},
       {[](auto& o) { o.knobs.clear(), o.values = {8}; }, "exactly one --knob"},
       {[](auto& o) { o.repeats = 0; }, "--repeats"},
-      {[](auto& o) { o.pipeline.encoder.resample_space = trm::ResampleSpace::Linear; }, "encoded space"},
       {[](auto& o) { o.pipeline.scene = "nosuchscene"; }, "nosuchscene"},
   };
   for (const Case& c : cases) {
@@ -266,3 +265,26 @@ TEST(Sweep, BadKnobsFailClearlyWithoutOutput) {
     }
   }
 }
+
+namespace {
+
+// The fixed-point decoders resample in linear light too: its knobs sweep there, and say why they skip elsewhere.
+TEST(Sweep, LinearResampleSpaceKnobsSweepInLinearSpaceOnly) {
+  auto linear = small_sweep("linear_resample_frac_bits", 16, 12, 2);
+  linear.pipeline.encoder.resample_space = trm::ResampleSpace::Linear;
+  linear.values = {16, 24};
+  const auto swept = trm::cli::run_sweep(linear);
+  ASSERT_EQ(swept.knobs.size(), 1u);
+  EXPECT_TRUE(swept.knobs[0].skipped.empty());
+  ASSERT_EQ(swept.knobs[0].points.size(), 3u);  // 16, 24 and the base 32
+  EXPECT_EQ(swept.knobs[0].points[2].value, 32);
+  EXPECT_TRUE(swept.knobs[0].points[2].is_default);
+  EXPECT_TRUE(swept.knobs[0].points[1].ok());
+
+  auto encoded = small_sweep("linear_resample_frac_bits", 16, 12, 2);
+  const auto skipped = trm::cli::run_sweep(encoded);
+  ASSERT_EQ(skipped.knobs.size(), 1u);
+  EXPECT_NE(skipped.knobs[0].skipped.find("--resample-space linear"), std::string::npos) << skipped.knobs[0].skipped;
+}
+
+}  // namespace

@@ -47,8 +47,7 @@ Json events_json(const FixedStageCounts& c) {
             {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
   j["skipped"] = {{"motion_test_lines", c.motion_test_lines_skipped},
                   {"residual_read_lines", c.residual_read_lines_skipped},
-                  {"residual_write_lines", c.residual_write_lines_skipped},
-                  {"grey_pixels", c.grey_pixels_skipped}};
+                  {"residual_write_lines", c.residual_write_lines_skipped}};
   return j;
 }
 

@@ -59,6 +59,19 @@ std::vector<SweepKnob> make_knobs() {
   knobs.push_back(field_knob("gaussian_line_frac_bits", "D vertical line buffer: horizontal results in codes uQb.L",
                              "line buffer (vertical Gaussian)", {0, 2, 4, 6, 8, 10, 12, 14, 16, 20, 24},
                              &FixedDecoderConfig::gaussian_line_frac_bits));
+  SweepKnob linear_resample = field_knob(
+      "linear_resample_frac_bits",
+      "linear resample space: lin(E) ROM words and D's input uQ1.P (--resample-space linear only)",
+      "ROM (lin(E) per link code), line buffer (vertical Gaussian)", {16, 20, 24, 26, 28, 30, 32, 36, 40},
+      &FixedDecoderConfig::linear_resample_frac_bits);
+  linear_resample.linear_space_only = true;
+  knobs.push_back(std::move(linear_resample));
+  SweepKnob linear_taps = field_knob("linear_gaussian_tap_frac_bits",
+                                     "linear resample space: D taps uQ0.T, summing to 2^T (--resample-space linear only)",
+                                     "arithmetic width only", {8, 12, 16, 20, 24, 28, 30},
+                                     &FixedDecoderConfig::linear_gaussian_tap_frac_bits);
+  linear_taps.linear_space_only = true;
+  knobs.push_back(std::move(linear_taps));
   knobs.push_back(field_knob("bilinear_weight_frac_bits", "U (bilinear) weights uQ0.W", "arithmetic width only",
                              {4, 6, 8, 10, 12, 14, 16, 20, 24}, &FixedDecoderConfig::bilinear_weight_frac_bits));
   knobs.push_back(field_knob("upsample_frac_bits", "U output in codes uQb.U (EOTF ROM address + interpolation weight)",
@@ -113,7 +126,13 @@ std::string knob_list() {
   return list;
 }
 
-bool applies(const SweepKnob& knob, PanelKind kind) { return kind == PanelKind::Lcd ? knob.lcd : knob.oled; }
+// Why a knob does nothing for this panel and resample space, or empty when it applies.
+std::string not_applicable(const SweepKnob& knob, PanelKind kind, ResampleSpace space) {
+  if (kind == PanelKind::Lcd && !knob.lcd) return "not used with the LCD panel";
+  if (kind == PanelKind::Oled && !knob.oled) return "used with the LCD panel only";
+  if (knob.linear_space_only && space != ResampleSpace::Linear) return "used with --resample-space linear only";
+  return "";
+}
 
 // The reference's output of one view, and the view as sent.
 struct RecordedView {
@@ -493,9 +512,6 @@ void SweepOptions::validate() const {
   }
   if (repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
   if (hw_size.width < 1 || hw_size.height < 1) throw std::invalid_argument("--hw-size must be WxH with W, H >= 1");
-  if (pipeline.encoder.resample_space != ResampleSpace::Encoded) {
-    throw std::invalid_argument("the fixed-point decoder resamples in the encoded space only: drop --resample-space");
-  }
   pipeline.validate();
 }
 
@@ -530,7 +546,7 @@ SweepResult run_sweep(const SweepOptions& options,
   std::vector<std::vector<int>> values(chosen.size());
   std::int64_t decodes = 1;  // the base point
   for (std::size_t i = 0; i < chosen.size(); ++i) {
-    if (!applies(*chosen[i], panel.kind)) continue;
+    if (!not_applicable(*chosen[i], panel.kind, options.pipeline.encoder.resample_space).empty()) continue;
     std::set<int> set(options.values.empty() ? chosen[i]->values.begin() : options.values.begin(),
                       options.values.empty() ? chosen[i]->values.end() : options.values.end());
     set.insert(chosen[i]->get(base));
@@ -569,8 +585,8 @@ SweepResult run_sweep(const SweepOptions& options,
     SweepKnobResult kr;
     kr.knob = &knob;
     kr.default_value = knob.get(base);
-    if (!applies(knob, panel.kind)) {
-      kr.skipped = panel.kind == PanelKind::Lcd ? "not used with the LCD panel" : "used with the LCD panel only";
+    kr.skipped = not_applicable(knob, panel.kind, options.pipeline.encoder.resample_space);
+    if (!kr.skipped.empty()) {
       result.knobs.push_back(std::move(kr));
       continue;
     }

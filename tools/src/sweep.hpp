@@ -28,6 +28,7 @@ struct SweepKnob {
   std::vector<int> values;  // the default sweep range (the base value is always added)
   bool oled = true;         // used with an OLED panel
   bool lcd = true;          // used with the LCD panel
+  bool linear_space_only = false;  // used when D and U act in linear light (--resample-space linear) only
   std::function<int(const FixedDecoderConfig&)> get;
   // Sets the knob on a copy of the base configuration; may throw std::invalid_argument (the point is rejected).
   std::function<void(FixedDecoderConfig&, int)> set;

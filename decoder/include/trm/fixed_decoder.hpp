@@ -162,10 +162,6 @@ struct FixedStageCounts {
   std::uint64_t motion_test_lines_skipped = 0;    // reduced: lines whose motion test was skipped (static, w = 1)
   std::uint64_t residual_read_lines_skipped = 0;  // reduced: lines with no residual to read or add
   std::uint64_t residual_write_lines_skipped = 0; // full: lines whose rho is all zero (not written to the store)
-  // Grey pixels (R = G = B along the path) computed on one channel: not implemented, always 0. It could only apply
-  // with equal per-channel panel gammas (LCD, or an OLED with one gamma; not the Vive / Rift presets, whose drive
-  // ROMs differ per channel) and, on LCD, equal v_{t-1} and x_{t-1} across the pixel's channels.
-  std::uint64_t grey_pixels_skipped = 0;
 
   // Totals over frames.
   FixedStageCounts& operator+=(const FixedStageCounts& c) {
@@ -178,7 +174,6 @@ struct FixedStageCounts {
     motion_test_lines_skipped += c.motion_test_lines_skipped;
     residual_read_lines_skipped += c.residual_read_lines_skipped;
     residual_write_lines_skipped += c.residual_write_lines_skipped;
-    grey_pixels_skipped += c.grey_pixels_skipped;
     return *this;
   }
 };
