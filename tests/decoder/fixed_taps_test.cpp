@@ -4,6 +4,8 @@
 
 #include "decoder_test_support.hpp"
 
+#include "trm/resample.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -121,6 +123,65 @@ TEST(FixedHardwareReport, RomsArithmeticAndFrameStores) {
     const std::int64_t reduced = 3LL * 540 * 600;
     EXPECT_EQ(r.paper_frame_store_bits, full * 8 + full * 30);  // residual sQ2.28
     EXPECT_EQ(r.model_frame_store_bits, reduced * 8 + full * 30);
+  }
+}
+
+// The ROM and arithmetic entries, derived here from the formats and the geometry alone (not from the decoder's own
+// tables): a change of a format or a stage that the report does not follow fails this test.
+TEST(FixedHardwareReport, RomsAndArithmeticFollowTheFormats) {
+  for (const int output_bits : {8, 10}) {
+    for (const cv::Size view : {cv::Size(1080, 1200), cv::Size(31, 19)}) {
+      SCOPED_TRACE(std::to_string(output_bits) + "-bit drive at " + std::to_string(view.width) + "x" +
+                   std::to_string(view.height));
+      FixedDecoderConfig config = taps_config("vive");
+      config.decoder.output_bits = output_bits;
+      const FixedStreamingDecoder decoder(config);
+      const FixedStreamingReport r = decoder.report(view);
+      const int link_codes = 1 << config.decoder.link.bits;
+      const int linear_word = 1 + config.linear_frac_bits;  // uQ1.F
+      const auto rom = [&](const std::string& prefix) {
+        const auto it = std::find_if(r.roms.begin(), r.roms.end(),
+                                     [&](const FixedRomReport& x) { return x.name.rfind(prefix, 0) == 0; });
+        EXPECT_NE(it, r.roms.end()) << prefix;
+        return it == r.roms.end() ? FixedRomReport{} : *it;
+      };
+      const FixedRomReport lin = rom("I = lin(E)");
+      EXPECT_EQ(lin.entries, link_codes);
+      EXPECT_EQ(lin.word_bits, linear_word);
+      const FixedRomReport eotf = rom("L, alpha = lin(U(.))");
+      EXPECT_EQ(eotf.entries, (link_codes - 1) * (1 << config.eotf_segments_per_code_log2) + 1);
+      EXPECT_EQ(eotf.word_bits, linear_word);
+      const FixedRomReport thresholds = rom("OLED drive thresholds");
+      EXPECT_EQ(thresholds.count, 3);  // one per channel: the Vive's gammas differ per primary
+      EXPECT_EQ(thresholds.entries, 1 << output_bits);
+      EXPECT_EQ(thresholds.word_bits, linear_word);
+      EXPECT_EQ(rom("Eq. 6 exp(-f)").entries, config.exp_entries);
+      EXPECT_EQ(rom("Eq. 5 1/(Yp + Ya)").entries, config.reciprocal_entries);
+
+      // Per output pixel: operators x evaluations / (W H), with the evaluations counted from the geometry.
+      const double pixels = static_cast<double>(view.width) * view.height;
+      const int reduced_width = reduced_size(view.width, 0.5), reduced_height = reduced_size(view.height, 0.5);
+      int taps = 0;  // the polyphase filter's length: the longest phase
+      for (int x = 0; x < reduced_width; ++x) {
+        taps = std::max(taps, static_cast<int>(gaussian_taps(x, view.width, reduced_width, 2.5).weights.size()));
+      }
+      const auto stage = [&](const std::string& prefix) {
+        const auto it = std::find_if(r.arithmetic.begin(), r.arithmetic.end(),
+                                     [&](const FixedArithmeticReport& a) { return a.stage.rfind(prefix, 0) == 0; });
+        EXPECT_NE(it, r.arithmetic.end()) << prefix;
+        return it == r.arithmetic.end() ? FixedArithmeticReport{} : *it;
+      };
+      const FixedArithmeticReport horizontal = stage("D horizontal");
+      EXPECT_EQ(horizontal.evaluations, 3LL * reduced_width * view.height);
+      EXPECT_EQ(horizontal.multipliers, taps);
+      const FixedArithmeticReport vertical = stage("D vertical");
+      EXPECT_EQ(vertical.evaluations, 3LL * reduced_width * reduced_height);
+      const FixedArithmeticReport drive = stage("OLED drive code");
+      EXPECT_EQ(drive.evaluations, 3LL * view.width * view.height);
+      EXPECT_EQ(drive.comparators, output_bits);  // a binary search over 2^b thresholds
+      EXPECT_EQ(stage("Eq. 5 motion contrast").evaluations, static_cast<std::int64_t>(pixels));
+      EXPECT_EQ(stage("U bilinear of i").evaluations, 3LL * view.width * view.height);
+    }
   }
 }
 
