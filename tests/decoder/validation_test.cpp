@@ -1,9 +1,11 @@
 // Configuration and input validation of the reference decoder: clear std::invalid_argument, never garbage.
 #include "decoder_test_support.hpp"
+#include "trm/fixed_decoder.hpp"
 
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <memory>
 #include <string>
 
 namespace trm {
@@ -112,6 +114,34 @@ TEST(DecoderOutput, StagesAreOnlyRecordedOnRequest) {
   config.record_stages = false;
   ReferenceDecoder decoder(config);
   EXPECT_FALSE(decoder.decode(TrmEncoder(link).encode(test::random_image(5, 5, 43), 0)).stages.has_value());
+}
+
+}  // namespace
+}  // namespace trm
+
+namespace trm {
+namespace {
+
+// Every decoder behind the one interface, by name: the same view decodes through each to the same size, and the
+// fixed-point ones report their stage events (the streaming one its hardware too).
+TEST(DecoderFactory, EveryNameMakesItsDecoderAndUnknownNamesAreListed) {
+  FixedDecoderConfig config;
+  config.decoder = test::decoder_config(EncoderConfig{});
+  const TrmEncoder encoder(config.decoder.link);
+  const LinkFrame full = encoder.encode(test::random_image(11, 9, 5), 0);
+  ASSERT_EQ(decoder_names(), (std::vector<std::string>{"reference", "fixed", "fixed-frame"}));
+  for (const std::string& name : decoder_names()) {
+    const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(name, config);
+    EXPECT_EQ(decoder->name(), name);
+    const DecodedFrame decoded = decoder->decode(full);
+    EXPECT_EQ(decoded.drive_codes.size(), cv::Size(11, 9)) << name;
+    EXPECT_EQ(decoder->stage_counts() != nullptr, name != "reference") << name;
+    FixedStreamingReport hardware;
+    EXPECT_EQ(decoder->hardware_report(cv::Size(11, 9), hardware), name == "fixed") << name;
+  }
+  const std::string message = test::error_of([&] { (void)make_decoder("fixed-point", config); });
+  EXPECT_NE(message.find("'fixed-point'"), std::string::npos) << message;
+  EXPECT_NE(message.find("reference, fixed, fixed-frame"), std::string::npos) << message;
 }
 
 }  // namespace

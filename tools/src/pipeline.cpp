@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <chrono>
@@ -288,10 +289,15 @@ void PipelineOptions::validate() const {
   validate_refresh_hz(refresh_hz, "--refresh");
   if (frames < 0) throw std::invalid_argument("--frames must be >= 0");
   if (output_bits != 8 && output_bits != 10) throw std::invalid_argument("output bits must be 8 or 10");
-  if (impl != "reference" && impl != "fixed" && impl != "fixed-frame") {
-    throw std::invalid_argument("unknown decoder implementation '" + impl + "' (available: reference, fixed, fixed-frame)");
+  const std::vector<std::string>& decoders = decoder_names();
+  if (std::find(decoders.begin(), decoders.end(), impl) == decoders.end()) {
+    std::string list;
+    for (const std::string& name : decoders) list += (list.empty() ? "" : ", ") + name;
+    throw std::invalid_argument("unknown decoder implementation --impl '" + impl + "' (available: " + list + ")");
   }
-  (void)parse_panel(panel);
+  // The decoder's whole configuration, before any output exists: the fixed-point formats only for those decoders.
+  const FixedDecoderConfig decoder_config = fixed_config_of(*this);
+  if (impl == "reference") decoder_config.decoder.validate(); else decoder_config.validate();
   // Link and fault options are checked whether or not they switch the link on (--ber -1 is an error either way).
   (void)link_config(width, height);
   if (input.empty()) {
@@ -325,20 +331,13 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   }
 
   TrmEncoder encoder(options.encoder);
-  DecoderConfig decoder_config;
-  decoder_config.link = options.encoder;
-  decoder_config.sensitivity = options.sensitivity;
-  decoder_config.panel = parse_panel(options.panel);
-  decoder_config.output_bits = options.output_bits;
-  decoder_config.lcd_history = options.lcd_history;
-  ReferenceDecoder decoder(decoder_config);
   const FixedDecoderConfig fixed_config = fixed_config_of(options);
-  std::optional<FixedStreamingDecoder> streaming;
-  std::optional<FixedFrameDecoder> frame_at_a_time;
-  if (options.impl == "fixed") streaming.emplace(fixed_config);
-  if (options.impl == "fixed-frame") frame_at_a_time.emplace(fixed_config);
-  const bool fixed = streaming || frame_at_a_time;
-  const bool compare = fixed && options.compare_reference;
+  const DecoderConfig& decoder_config = fixed_config.decoder;
+  const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(options.impl, fixed_config);
+  // The reference beside a fixed-point decoder sees exactly the same input.
+  const bool compare = options.compare_reference && options.impl != "reference";
+  std::optional<ReferenceDecoder> reference_beside;
+  if (compare) reference_beside.emplace(decoder_config);
   // LCD codes compared free-running drift apart by the design's neutral mode (see adopt_panel_history); the
   // synchronised comparison is the criterion, the free-running one is reported beside it.
   std::optional<ReferenceDecoder> free_running;
@@ -356,22 +355,6 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     result.link.emplace();
   }
 
-  // The decoder under test; the reference beside it (compare) sees exactly the same input.
-  const auto decode_whole = [&](const LinkFrame& frame) {
-    if (streaming) return streaming->decode(frame);
-    if (frame_at_a_time) return frame_at_a_time->decode(frame);
-    return decoder.decode(frame);
-  };
-  const auto decode_partial = [&](const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-    if (streaming) return streaming->decode(frame, line_intact);
-    if (frame_at_a_time) return frame_at_a_time->decode(frame, line_intact);
-    return decoder.decode(frame, line_intact);
-  };
-  const auto decode_lost = [&](const FrameMeta& meta) {
-    if (streaming) return streaming->decode_lost(meta);
-    if (frame_at_a_time) return frame_at_a_time->decode_lost(meta);
-    return decoder.decode_lost(meta);
-  };
   const int eyes = options.encoder.stereo ? 2 : 1;
   std::vector<LinkFrame> sent(static_cast<std::size_t>(eyes));
   std::vector<double> encode_seconds(static_cast<std::size_t>(eyes));
@@ -403,30 +386,30 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
         }
         if (arrived) {
           const LinkFrame frame{arrived->meta, arrived->codes};
-          decoded = decode_partial(frame, arrived->line_intact);
+          decoded = decoder->decode(frame, arrived->line_intact);
           decode_seconds = seconds_since(start);
           if (compare) {
-            reference = decoder.decode(frame, arrived->line_intact);
+            reference = reference_beside->decode(frame, arrived->line_intact);
             if (free_running) {
-              decoder.adopt_panel_history(decoded);
+              reference_beside->adopt_panel_history(decoded);
               free_running_reference = free_running->decode(frame, arrived->line_intact);
             }
           }
         } else {
-          decoded = decode_lost(view_sent.meta);
+          decoded = decoder->decode_lost(view_sent.meta);
           decode_seconds = seconds_since(start);
-          if (compare) reference = decoder.decode_lost(view_sent.meta);
+          if (compare) reference = reference_beside->decode_lost(view_sent.meta);
           if (free_running) free_running_reference = free_running->decode_lost(view_sent.meta);
           ++result.link->lost_views;
         }
         result.link->concealed_lines += decoded.stats.concealed_lines;
       } else {
-        decoded = decode_whole(view_sent);
+        decoded = decoder->decode(view_sent);
         decode_seconds = seconds_since(start);
         if (compare) {
-          reference = decoder.decode(view_sent);
+          reference = reference_beside->decode(view_sent);
           if (free_running) {
-            decoder.adopt_panel_history(decoded);
+            reference_beside->adopt_panel_history(decoded);
             free_running_reference = free_running->decode(view_sent);
           }
         }
@@ -438,7 +421,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       view.decoded = &decoded;
       if (compare) view.reference = &reference;
       if (free_running) view.free_running_reference = &free_running_reference;
-      if (fixed) view.fixed_counts = streaming ? &streaming->last_counts() : &frame_at_a_time->last_counts();
+      view.fixed_counts = decoder->stage_counts();
       view.render_seconds = render_seconds;
       view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];
       view.decode_seconds = decode_seconds;
@@ -446,7 +429,9 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     }
   }
   result.frames = frames;
-  if (streaming) result.hardware = streaming->report(cv::Size(source->width(), source->height()));
+  if (FixedStreamingReport hardware; decoder->hardware_report(cv::Size(source->width(), source->height()), hardware)) {
+    result.hardware = std::move(hardware);
+  }
   if (simulation) {
     simulation->finish();
     result.link->summary = simulation->meter().summary();
@@ -495,22 +480,11 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
   config.output_bits = options.output_bits;
   config.lcd_history = options.lcd_history;
   // The selected implementation; the fixed-point ones take the capture's link configuration as well.
-  std::optional<ReferenceDecoder> reference;
-  std::optional<FixedStreamingDecoder> streaming;
-  std::optional<FixedFrameDecoder> frame_at_a_time;
-  PipelineOptions fixed_options = options;
-  fixed_options.encoder = config.link;
-  if (options.impl == "fixed") {
-    streaming.emplace(fixed_config_of(fixed_options));
-  } else if (options.impl == "fixed-frame") {
-    frame_at_a_time.emplace(fixed_config_of(fixed_options));
-  } else {
-    reference.emplace(config);
-  }
-  const auto decode_lost = [&](const FrameMeta& lost) {
-    return streaming ? streaming->decode_lost(lost) : frame_at_a_time ? frame_at_a_time->decode_lost(lost)
-                                                                      : reference->decode_lost(lost);
-  };
+  PipelineOptions capture_options = options;
+  capture_options.encoder = config.link;
+  FixedDecoderConfig decoder_config = fixed_config_of(capture_options);
+  decoder_config.decoder = config;
+  const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(options.impl, decoder_config);
 
   // Views in link order: (t, eye) as t * eyes + eye. A view that lost every packet never comes out of the receiver;
   // the panel holds its previous output for it, and it is decoded and handed on as lost.
@@ -533,7 +507,7 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
       lost.height = full ? full_size.height : reduced_size(full_size.height, config.link.reduction);
       lost.bits = config.link.bits;
       lost.transfer = config.link.transfer;
-      const DecodedFrame decoded = decode_lost(lost);
+      const DecodedFrame decoded = decoder->decode_lost(lost);
       ++result.views;
       ++result.lost_views;
       sink(lost, nullptr, decoded);
@@ -564,9 +538,7 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
     if (m.eye == 1) right_eye_arrived = true;
     hand_on_lost_views_before(view_number);
     const LinkFrame frame{m, received->codes};
-    const DecodedFrame decoded = streaming         ? streaming->decode(frame, received->line_intact)
-                                 : frame_at_a_time ? frame_at_a_time->decode(frame, received->line_intact)
-                                                   : reference->decode(frame, received->line_intact);
+    const DecodedFrame decoded = decoder->decode(frame, received->line_intact);
     result.concealed_lines += decoded.stats.concealed_lines;
     ++result.views;
     ++next_view;

@@ -187,9 +187,9 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
   std::vector<std::vector<double>> view_seconds(rec.views.size());
   for (int repeat = 0; repeat < options.repeats; ++repeat) {
     const auto setup_start = Clock::now();
-    std::optional<FixedStreamingDecoder> decoder;
+    std::unique_ptr<HeadsetDecoder> decoder;
     try {
-      decoder.emplace(config);
+      decoder = make_decoder("fixed", config);  // the hardware model
     } catch (const std::invalid_argument& e) {
       p.status = "rejected";
       p.message = e.what();
@@ -197,7 +197,9 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
     }
     if (repeat == 0) {
       p.setup_seconds = seconds_since(setup_start);
-      const Json totals = hardware_json(decoder->report(options.hw_size))["totals"];
+      FixedStreamingReport hardware;
+      if (!decoder->hardware_report(options.hw_size, hardware)) throw std::logic_error("the sweep needs a hardware model");
+      const Json totals = hardware_json(hardware)["totals"];
       p.on_chip_bits = totals["on_chip_bits"].get<std::int64_t>();
       p.off_chip_bits = totals["off_chip_bits"].get<std::int64_t>();
     }
@@ -218,7 +220,7 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
         return p;
       }
       if (repeat > 0) continue;
-      const FixedStageCounts& counts = decoder->last_counts();
+      const FixedStageCounts& counts = *decoder->stage_counts();
       p.residual_saturated += counts.residual_saturated;
       p.residual_rounded += counts.residual_rounded;
       cv::Mat difference;
@@ -532,7 +534,7 @@ SweepResult run_sweep(const SweepOptions& options,
   options.validate();
   const Panel panel = parse_panel(options.pipeline.panel);
   const FixedDecoderConfig base = fixed_config_of(options.pipeline);
-  (void)FixedStreamingDecoder(base);  // an unusable base configuration fails the whole sweep, with its message
+  (void)make_decoder("fixed", base);  // an unusable base configuration fails the whole sweep, with its message
 
   SweepResult result;
   result.options = options;

@@ -14,7 +14,7 @@
 
 #include "trm/fixed_runtime.hpp"
 #include "trm/frame.hpp"
-#include "trm/reference_decoder.hpp"
+#include "trm/decoder.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -272,24 +272,26 @@ struct Concealment;
 }
 
 // Frame-at-a-time schedule.
-class FixedFrameDecoder {
+class FixedFrameDecoder : public HeadsetDecoder {
  public:
   explicit FixedFrameDecoder(FixedDecoderConfig config);  // validates; throws std::invalid_argument
-  ~FixedFrameDecoder();
+  ~FixedFrameDecoder() override;
   FixedFrameDecoder(FixedFrameDecoder&&) noexcept;
   FixedFrameDecoder& operator=(FixedFrameDecoder&&) noexcept;
+  const char* name() const override { return "fixed-frame"; }
+  const FixedStageCounts* stage_counts() const override { return &last_counts(); }
 
   const FixedDecoderConfig& config() const;
   // As ReferenceDecoder::decode: one view, per-eye state; the doubles are the fixed values converted exactly.
-  DecodedFrame decode(const LinkFrame& frame);
+  DecodedFrame decode(const LinkFrame& frame) override;
   // The same, also filling taps with every stage's integer plane of this frame (the others are not present).
   DecodedFrame decode(const LinkFrame& frame, FixedStageTaps& taps);
   // As ReferenceDecoder::decode(frame, line_intact): a view received over a faulty link, line_intact holding one
   // entry per line of frame.codes (0 = lost; empty = none lost), concealed by the reference's rules.
-  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) override;
   // As ReferenceDecoder::decode_lost: the panel holds this eye's previous output (black if none), the residual is
   // dropped.
-  DecodedFrame decode_lost(const FrameMeta& meta);
+  DecodedFrame decode_lost(const FrameMeta& meta) override;
   const FixedStageCounts& last_counts() const;
 
  private:
@@ -298,19 +300,25 @@ class FixedFrameDecoder {
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
-class FixedStreamingDecoder {
+class FixedStreamingDecoder : public HeadsetDecoder {
  public:
   explicit FixedStreamingDecoder(FixedDecoderConfig config);
-  ~FixedStreamingDecoder();
+  ~FixedStreamingDecoder() override;
   FixedStreamingDecoder(FixedStreamingDecoder&&) noexcept;
   FixedStreamingDecoder& operator=(FixedStreamingDecoder&&) noexcept;
+  const char* name() const override { return "fixed"; }
+  const FixedStageCounts* stage_counts() const override { return &last_counts(); }
+  bool hardware_report(cv::Size full, FixedStreamingReport& out) const override {
+    out = report(full);
+    return true;
+  }
 
   const FixedDecoderConfig& config() const;
-  DecodedFrame decode(const LinkFrame& frame);
+  DecodedFrame decode(const LinkFrame& frame) override;
   // Concealment as FixedFrameDecoder (bit-identical), with every lost line replaced as it arrives, in raster order
   // (see FixedStreamingReport::concealment).
-  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
-  DecodedFrame decode_lost(const FrameMeta& meta);
+  DecodedFrame decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) override;
+  DecodedFrame decode_lost(const FrameMeta& meta) override;
   const FixedStageCounts& last_counts() const;
   // Latency, line buffers / frame stores, ROMs and arithmetic per stage for a view of the given full size.
   FixedStreamingReport report(cv::Size full) const;
