@@ -1,6 +1,6 @@
 #include "trm/bandwidth.hpp"
 
-#include "atomic_file.hpp"
+#include "trm/atomic_file.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -99,7 +99,7 @@ void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFra
         << u.utilisation << ',' << (u.fits ? 1 : 0) << '\n';
   }
   const std::string text = out.str();
-  detail::write_file_atomically(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  io::write_file_atomically(path, text);
 }
 
 }  // namespace trm::link
