@@ -46,6 +46,14 @@ bool is_registered(const fs::path& staging) {
                      [&](const Entry& e) { return e.staging.filename() == staging.filename(); });
 }
 
+// Whether dir is a staging directory of this process: fresh and private, so it holds nothing stale.
+bool is_our_staging(const fs::path& dir) {
+  Registry& r = registry();
+  std::lock_guard lock(r.mutex);
+  const fs::path d = dir.lexically_normal();
+  return std::any_of(r.entries.begin(), r.entries.end(), [&](const Entry& e) { return e.staging.lexically_normal() == d; });
+}
+
 std::string reason(int error) { return std::strerror(error); }
 
 const char* kind_of(mode_t mode) {
@@ -106,7 +114,10 @@ void check_file_target(const fs::path& target) {
   }
   if (errno != ENOENT) refuse(reason(errno));
   const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  if (::stat(parent.c_str(), &st) != 0) refuse("directory '" + shown(parent) + "': " + reason(errno));
+  if (::stat(parent.c_str(), &st) != 0) {
+    const int error = errno;
+    refuse("directory '" + shown(parent) + "': " + reason(error));
+  }
   if (!S_ISDIR(st.st_mode)) refuse("'" + shown(parent) + "' is not a directory");
 }
 
@@ -223,14 +234,15 @@ constexpr std::size_t kBufferBytes = 1 << 20;
 
 AtomicFile::AtomicFile(const fs::path& target) : target_(target) {
   check_file_target(target_);
-  remove_stale_staging(target_);
+  if (!is_our_staging(target_.parent_path())) remove_stale_staging(target_);  // no scan per file of an output dir
   for (int attempt = 0;; ++attempt) {
     try {
       staging_ = StagingGuard(staging_sibling(target_), target_, [&](const fs::path& path) {
         fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd_ >= 0) return;
-        if (errno == EEXIST && attempt < 100) throw NameTaken{};
-        throw std::runtime_error("cannot write '" + shown(target_) + "': " + reason(errno));
+        const int error = errno;
+        if (error == EEXIST && attempt < 100) throw NameTaken{};
+        throw std::runtime_error("cannot write '" + shown(target_) + "': " + reason(error));
       });
       return;
     } catch (const NameTaken&) {
