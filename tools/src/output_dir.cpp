@@ -96,21 +96,38 @@ OutputDir::OutputDir(const fs::path& target) : target_(fs::absolute(target).lexi
   check_replaceable(target_);
   const fs::path parent = target_.parent_path();
   std::error_code ec;
+  for (fs::path p = parent; !p.empty() && p != p.root_path() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path())
+    created_parents_.push_back(p);
   fs::create_directories(parent, ec);
-  if (ec) throw std::runtime_error("cannot create '" + parent.string() + "': " + ec.message());
-  io::remove_stale_staging(target_);
-  for (int attempt = 0;; ++attempt) {
-    try {
-      staging_ = io::StagingGuard(io::staging_sibling(target_), target_, [&](const fs::path& path) {
-        if (fs::create_directory(path, ec)) return;
-        if (!ec && attempt < 100) throw NameTaken{};  // a stale entry of an earlier process with our PID
-        throw std::runtime_error("cannot create a staging directory next to '" + target_.string() + "': " +
-                                 (ec ? ec.message() : std::string("name taken")));
-      });
-      return;
-    } catch (const NameTaken&) {
+  try {
+    if (ec) throw std::runtime_error("cannot create '" + parent.string() + "': " + ec.message());
+    io::remove_stale_staging(target_);
+    for (int attempt = 0; staging_.path().empty(); ++attempt) {
+      try {
+        staging_ = io::StagingGuard(io::staging_sibling(target_), target_, [&](const fs::path& path) {
+          if (fs::create_directory(path, ec)) return;
+          if (!ec && attempt < 100) throw NameTaken{};  // a stale entry of an earlier process with our PID
+          throw std::runtime_error("cannot create a staging directory next to '" + target_.string() + "': " +
+                                   (ec ? ec.message() : std::string("name taken")));
+        });
+      } catch (const NameTaken&) {
+      }
     }
+  } catch (...) {
+    remove_created_parents();
+    throw;
   }
+}
+
+void OutputDir::remove_created_parents() const {
+  std::error_code ignored;
+  for (const fs::path& p : created_parents_) fs::remove(p, ignored);  // only while still empty
+}
+
+OutputDir::~OutputDir() {
+  if (committed_) return;
+  staging_.reset();
+  remove_created_parents();
 }
 
 void OutputDir::write_png(const std::string& name, const cv::Mat& rgb) const {

@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace trm::cli {
 
@@ -25,7 +26,7 @@ class OutputDir {
   // Refuses (std::runtime_error) a target that is not a directory (a symbolic link included) and an existing
   // non-empty directory that is not a trm output as described above.
   explicit OutputDir(const std::filesystem::path& target);
-  ~OutputDir() = default;  // the staging guard removes an uncommitted staging directory
+  ~OutputDir();  // uncommitted: removes the staging directory and the parent directories it created
   OutputDir(const OutputDir&) = delete;
   OutputDir& operator=(const OutputDir&) = delete;
 
@@ -42,8 +43,11 @@ class OutputDir {
   void commit();
 
  private:
+  void remove_created_parents() const;
+
   std::filesystem::path target_;
   io::StagingGuard staging_;
+  std::vector<std::filesystem::path> created_parents_;  // deepest first
   bool committed_ = false;
 };
 
