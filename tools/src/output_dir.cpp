@@ -25,7 +25,8 @@ namespace trm::cli {
 namespace {
 
 [[noreturn]] void refuse(const fs::path& target, const std::string& why) {
-  throw std::runtime_error("output directory '" + target.string() + "' " + why + "; refusing to replace it");
+  throw std::runtime_error("output directory '" + target.string() + "' " + why +
+                           "; refusing to replace it (remove it yourself or give another directory)");
 }
 
 // The manifest of a previous trm output, or nullopt when the marker is missing or not trm's.
