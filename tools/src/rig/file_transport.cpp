@@ -2,7 +2,6 @@
 
 #include "rig/protocol.hpp"
 
-
 namespace trm::rig {
 
 FileTransport::FileTransport(FileTransportOptions options) : options_(std::move(options)) {
