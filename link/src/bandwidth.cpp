@@ -1,10 +1,11 @@
 #include "trm/bandwidth.hpp"
 
-#include "atomic_file.hpp"
+#include "trm/atomic_file.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -86,46 +87,23 @@ std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double
 }
 
 FramesCsvWriter::FramesCsvWriter(const std::filesystem::path& path, double refresh_hz)
-    : path_(path), temp_(detail::temporary_sibling(path)), refresh_hz_(refresh_hz) {
-  out_.open(temp_, std::ios::binary | std::ios::trunc);
-  out_ << "link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,"
-          "wire_time_s,available_time_s,utilisation,fits\n";
-  out_ << std::setprecision(9);
-  if (!out_) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_, ignored);
-    throw std::runtime_error("cannot write '" + path_.string() + "'");
-  }
-}
-
-FramesCsvWriter::~FramesCsvWriter() {
-  if (closed_) return;
-  out_.close();
-  std::error_code ignored;
-  std::filesystem::remove(temp_, ignored);
+    : file_(path), refresh_hz_(refresh_hz) {
+  file_.write("link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,"
+              "wire_time_s,available_time_s,utilisation,fits\n");
 }
 
 void FramesCsvWriter::add(const LinkFrameUsage& u) {
-  out_ << u.index << ',' << static_cast<double>(u.index) / refresh_hz_ << ',' << u.views << ',' << u.parities << ','
-       << u.bits.pixel_bits << ',' << u.bits.payload_bits << ',' << u.bits.overhead_bits << ',' << u.bits.wire_bits()
-       << ',' << u.bits.packets << ',' << u.wire_seconds << ',' << u.available_seconds << ',' << u.utilisation << ','
-       << (u.fits ? 1 : 0) << '\n';
+  std::ostringstream row;
+  row << std::setprecision(9) << u.index << ',' << static_cast<double>(u.index) / refresh_hz_ << ',' << u.views << ','
+      << u.parities << ',' << u.bits.pixel_bits << ',' << u.bits.payload_bits << ',' << u.bits.overhead_bits << ','
+      << u.bits.wire_bits() << ',' << u.bits.packets << ',' << u.wire_seconds << ',' << u.available_seconds << ','
+      << u.utilisation << ',' << (u.fits ? 1 : 0) << '\n';
+  file_.write(row.str());
 }
 
 void FramesCsvWriter::close() {
   if (closed_) return;
-  out_.close();
-  std::error_code ec;
-  if (!out_) {
-    std::filesystem::remove(temp_, ec);
-    throw std::runtime_error("cannot write '" + path_.string() + "'");
-  }
-  std::filesystem::rename(temp_, path_, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_, ignored);
-    throw std::runtime_error("cannot rename temporary file onto '" + path_.string() + "': " + ec.message());
-  }
+  file_.commit();
   closed_ = true;
 }
 

@@ -1,6 +1,5 @@
 #include "trm/capture.hpp"
 
-#include "atomic_file.hpp"
 #include "byte_io.hpp"
 #include "trm/packet.hpp"
 
@@ -30,13 +29,15 @@ constexpr std::uint32_t kEndRecordBytes = 16;  // u64 packet count, u64 packet b
 
 // ---------------------------------------------------------------------------------------------- writer
 
-CaptureWriter::CaptureWriter(const std::filesystem::path& path, const std::string& metadata)
-    : path_(path), temp_path_(detail::temporary_sibling(path)) {
+CaptureWriter::CaptureWriter(const std::filesystem::path& path, const std::string& metadata) : path_(path) {
   if (metadata.size() > kCaptureMaxMetadataBytes)
     throw CaptureError("capture metadata is " + std::to_string(metadata.size()) + " bytes, more than the " +
                        std::to_string(kCaptureMaxMetadataBytes) + " allowed");
-  out_.open(temp_path_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw CaptureError("cannot create capture file '" + path.string() + "'");
+  try {
+    file_ = std::make_unique<io::AtomicFile>(path);
+  } catch (const std::runtime_error& e) {
+    throw CaptureError(e.what());
+  }
   std::uint8_t header[kCaptureHeaderBytes] = {};
   std::memcpy(header + kOffMagic, kCaptureMagic, sizeof kCaptureMagic);
   detail::put_u16(header + kOffVersion, kCaptureFormatVersion);
@@ -45,16 +46,18 @@ CaptureWriter::CaptureWriter(const std::filesystem::path& path, const std::strin
   detail::put_u32(header + kOffMetadataLength, static_cast<std::uint32_t>(metadata.size()));
   detail::put_u32(header + kOffMetadataCrc,
                   detail::crc32_of({reinterpret_cast<const std::uint8_t*>(metadata.data()), metadata.size()}));
-  out_.write(reinterpret_cast<const char*>(header), sizeof header);
-  out_.write(metadata.data(), static_cast<std::streamsize>(metadata.size()));
-  if (!out_) throw CaptureError("cannot write capture file '" + path.string() + "'");
+  write(header);
+  write({reinterpret_cast<const std::uint8_t*>(metadata.data()), metadata.size()});
 }
 
-CaptureWriter::~CaptureWriter() {
-  if (!closed_) {
-    out_.close();
-    std::error_code ignored;
-    std::filesystem::remove(temp_path_, ignored);
+CaptureWriter::~CaptureWriter() = default;  // an unclosed AtomicFile removes its staging file
+
+void CaptureWriter::write(std::span<const std::uint8_t> bytes) {
+  try {
+    file_->write(bytes);
+  } catch (const std::runtime_error& e) {
+    closed_ = true;  // the staging file is gone
+    throw CaptureError(e.what());
   }
 }
 
@@ -66,9 +69,8 @@ void CaptureWriter::write_packet(std::span<const std::uint8_t> packet) {
   std::uint8_t record[kCaptureRecordHeaderBytes];
   std::memcpy(record, kRecordPacket, 4);
   detail::put_u32(record + 4, static_cast<std::uint32_t>(packet.size()));
-  out_.write(reinterpret_cast<const char*>(record), sizeof record);
-  out_.write(reinterpret_cast<const char*>(packet.data()), static_cast<std::streamsize>(packet.size()));
-  if (!out_) throw CaptureError("cannot write capture file '" + path_.string() + "'");
+  write(record);
+  write(packet);
   ++packets_;
   packet_bytes_ += packet.size();
 }
@@ -80,13 +82,13 @@ void CaptureWriter::close() {
   detail::put_u32(record + 4, kEndRecordBytes);
   detail::put_u64(record + 8, packets_);
   detail::put_u64(record + 16, packet_bytes_);
-  out_.write(reinterpret_cast<const char*>(record), sizeof record);
-  out_.close();
-  if (!out_) throw CaptureError("cannot write capture file '" + path_.string() + "'");
-  std::error_code ec;
-  std::filesystem::rename(temp_path_, path_, ec);
-  if (ec) throw CaptureError("cannot move capture into place at '" + path_.string() + "': " + ec.message());
+  write(record);
   closed_ = true;
+  try {
+    file_->commit();
+  } catch (const std::runtime_error& e) {
+    throw CaptureError(e.what());
+  }
 }
 
 // ---------------------------------------------------------------------------------------------- reader

@@ -1,6 +1,6 @@
 #include "trm/bandwidth.hpp"
 
-#include "atomic_file.hpp"
+#include "trm/atomic_file.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -169,7 +169,7 @@ void plot_bits_per_frame(const std::filesystem::path& path, std::span<const Plot
 
   std::vector<std::uint8_t> png;
   if (!cv::imencode(".png", canvas, png)) throw std::runtime_error("cannot encode plot '" + path.string() + "' as PNG");
-  detail::write_file_atomically(path, png);
+  io::write_file_atomically(path, png);
 }
 
 }  // namespace trm::link

@@ -129,7 +129,7 @@ TEST(Capture, MissingFileAndUnclosedWriter) {
   }  // destroyed without close(): nothing that looks like a capture is left
   EXPECT_FALSE(std::filesystem::exists(path));
   for (const auto& entry : std::filesystem::directory_iterator(out_dir()))
-    EXPECT_EQ(entry.path().filename().string().find("unclosed.trmcap.tmp"), std::string::npos);
+    EXPECT_EQ(entry.path().filename().string().find(".unclosed.trmcap.partial-"), std::string::npos);
   EXPECT_THROW(CaptureWriter(out_dir() / "no_such_dir" / "x.trmcap", ""), CaptureError);
 }
 

@@ -176,7 +176,7 @@ TEST(Bandwidth, CsvAndPlotAreWritten) {
   EXPECT_EQ(png.cols, 1200);
   EXPECT_EQ(png.rows, 640);
   for (const auto& entry : std::filesystem::directory_iterator(dir))
-    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << "temporary file left: " << entry.path();
+    EXPECT_EQ(entry.path().string().find(".partial-"), std::string::npos) << "staging file left: " << entry.path();
   EXPECT_THROW(write_frames_csv(dir / "no_such_dir" / "frames.csv", frames, 100.0), std::runtime_error);
 }
 

@@ -117,6 +117,7 @@ TEST(Hid, FileTransportWritesExactlyWhatTheDeviceReceived) {
   {
     FileTransport file({path, FileTransportOptions::Framing::Hid, 0, HidReportFormat{64, 9, false}});
     feed_all(file, frames);
+    file.finish();
   }
   std::ifstream in(path, std::ios::binary);
   const std::vector<std::uint8_t> written{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

@@ -81,6 +81,7 @@ TEST(UsbBulk, FileTransportWritesExactlyWhatTheDeviceReceived) {
   {
     FileTransport file({path, FileTransportOptions::Framing::Bulk, 512, {}});
     feed_all(file, frames);
+    file.finish();
   }
   const auto written = read_file(path);
   ::unlink(path.c_str());

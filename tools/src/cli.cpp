@@ -1,5 +1,7 @@
 #include "commands.hpp"
 
+#include "trm/atomic_file.hpp"
+
 #include <exception>
 #include <iostream>
 
@@ -10,6 +12,9 @@
 namespace trm::cli {
 
 int run_main(int argc, char** argv) {
+  // First, before any thread starts: every later thread inherits the blocked signals, so only the cleanup
+  // thread receives them.
+  io::install_signal_cleanup();
   CLI::App app{"trm: headset-side Temporal Resolution Multiplexing simulator "
                "(GPU-side encoder, simulated link, bit-accurate display-controller decoder, panel and eye models)"};
   app.set_version_flag("--version", std::string("trm ") + TRM_VERSION);

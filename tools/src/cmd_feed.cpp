@@ -9,6 +9,8 @@
 #include "rig/hid_transport.hpp"
 #include "rig/usb_bulk_transport.hpp"
 
+#include "trm/atomic_file.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
@@ -175,10 +177,19 @@ int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
 
   nlohmann::json summary;
   summary["protocol_version"] = rig::kProtocolVersion;
+  // Before anything is sent or created: a feed whose outputs cannot be written must not start.
+  if (!s.file.empty()) io::check_file_target(s.file);
+  if (!s.summary_path.empty()) io::check_file_target(s.summary_path);
   auto finish = [&](int exit_code) {
     const std::string text = summary.dump(2);
     std::cout << text << "\n";
-    if (!s.summary_path.empty()) std::ofstream(s.summary_path) << text << "\n";
+    if (s.summary_path.empty()) return exit_code;
+    try {
+      io::write_file_atomically(s.summary_path, text + "\n");
+    } catch (const std::runtime_error& e) {
+      std::cerr << "trm: error: --summary: " << e.what() << "\n";
+      return exit_code != 0 ? exit_code : 1;
+    }
     return exit_code;
   };
   auto record_error = [&](const rig::RigError& e) {
@@ -230,6 +241,7 @@ int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
     } else {
       run_pipeline(pipeline, [&](const DecodedView& view) { feed_decoded(*view.decoded); });
     }
+    transport->finish();
     summary["status"] = "ok";
   } catch (const rig::RigError& e) {
     exit_code = record_error(e);

@@ -4,6 +4,8 @@
 #include "hw_report.hpp"
 #include "output_dir.hpp"
 
+#include "trm/atomic_file.hpp"
+
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -23,6 +25,7 @@ void register_hw_report(CLI::App& app, Action& action) {
   cmd->callback([options, out, json, &action] {
     action = [options, out, json] {
       options->validate();
+      if (!json->empty()) io::check_file_target(*json);  // before --out is replaced
       FixedDecoderConfig config = fixed_config_of(*options);
       const FixedStreamingDecoder decoder(config);  // validates the configuration
       Json report;
@@ -42,7 +45,7 @@ void register_hw_report(CLI::App& app, Action& action) {
         dir.write_text("report.json", text);
         dir.commit();
       }
-      if (!json->empty()) write_file_atomically(*json, text);
+      if (!json->empty()) io::write_file_atomically(*json, text);
       std::cout << "trm hw-report: " << options->panel << ", r = " << options->encoder.reduction << " ("
                 << to_string(options->encoder.resample_space) << " resample space), "
                 << options->encoder.bits << "-bit link, " << options->output_bits << "-bit drive, residual "

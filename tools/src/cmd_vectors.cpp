@@ -5,6 +5,8 @@
 #include "output_dir.hpp"
 #include "vectors.hpp"
 
+#include "trm/atomic_file.hpp"
+
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -26,8 +28,12 @@ void register_vectors(CLI::App& app, Action& action) {
   cmd->callback([options, out, golden, &action] {
     action = [options, out, golden] {
       if (!golden->empty()) {
+        // The golden hashes cover a fixed set of scenes: an --out beside it would be silently ignored.
+        if (!out->empty())
+          throw std::invalid_argument("trm vectors: --update-golden FILE and --out DIR exclude each other");
+        io::check_file_target(*golden);  // before generating
         const std::string text = golden_vectors_text();
-        write_file_atomically(*golden, text);
+        io::write_file_atomically(*golden, text);
         std::cout << "trm vectors: wrote " << *golden << "\n";
         return 0;
       }

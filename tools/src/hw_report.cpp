@@ -2,8 +2,6 @@
 
 #include "trm/panel.hpp"
 
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -156,21 +154,6 @@ std::string hardware_summary(const Json& hw) {
     << p["saved_percent"].get<double>() << " %\n";
   if (hw.contains("concealment")) s << "concealment: " << hw["concealment"].get<std::string>() << "\n";
   return s.str();
-}
-
-void write_file_atomically(const std::string& path, const std::string& text) {
-  const std::filesystem::path temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      throw std::runtime_error("cannot write '" + path + "'");
-    }
-  }
-  std::filesystem::rename(temporary, path);
 }
 
 }  // namespace trm::cli

@@ -27,7 +27,5 @@ Json hardware_json(const FixedStreamingReport& report);
 // A human-readable summary of hardware_json's content.
 std::string hardware_summary(const Json& hardware);
 
-// Writes text to path whole or not at all (a temporary sibling renamed into place); throws std::runtime_error.
-void write_file_atomically(const std::string& path, const std::string& text);
 
 }  // namespace trm::cli

@@ -88,16 +88,11 @@ double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b) {
   return 10.0 * std::log10(1.0 / mse);
 }
 
-JsonLinesWriter::JsonLinesWriter(const std::filesystem::path& path) : path_(path), out_(path, std::ios::binary) {
-  if (!out_) throw std::runtime_error("cannot write '" + path_.string() + "'");
-}
+JsonLinesWriter::JsonLinesWriter(const std::filesystem::path& path) : path_(path), file_(path) {}
 
-void JsonLinesWriter::write(const Json& record) { out_ << record.dump() << '\n'; }
+void JsonLinesWriter::write(const Json& record) { file_.write(record.dump() + "\n"); }
 
-void JsonLinesWriter::close() {
-  out_.close();
-  if (!out_) throw std::runtime_error("cannot write '" + path_.string() + "'");
-}
+void JsonLinesWriter::close() { file_.commit(); }
 
 RunRecorder::RunRecorder(const PipelineOptions& options, const std::filesystem::path& directory)
     : options_(options),

@@ -2,6 +2,8 @@
 // statistics for report.json's summary, and renders the human-readable summary table.
 #pragma once
 
+#include "trm/atomic_file.hpp"
+
 #include "pipeline.hpp"
 
 #include <nlohmann/json.hpp>
@@ -26,12 +28,12 @@ class JsonLinesWriter {
  public:
   explicit JsonLinesWriter(const std::filesystem::path& path);  // throws std::runtime_error naming the path
   void write(const Json& record);
-  void close();  // flushes; throws on an I/O failure
+  void close();  // moves the file into place; throws on an I/O failure
   std::string file_name() const { return path_.filename().string(); }
 
  private:
   std::filesystem::path path_;
-  std::ofstream out_;
+  io::AtomicFile file_;  // the one file writer: every failure names the file and the reason
 };
 
 class RunRecorder {

@@ -3,6 +3,7 @@
 
 #include "trm/link.hpp"
 #include "trm/presets.hpp"
+#include "trm/atomic_file.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -92,16 +93,12 @@ std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double
 class FramesCsvWriter {
  public:
   FramesCsvWriter(const std::filesystem::path& path, double refresh_hz);
-  ~FramesCsvWriter();
-  FramesCsvWriter(const FramesCsvWriter&) = delete;
-  FramesCsvWriter& operator=(const FramesCsvWriter&) = delete;
   void add(const LinkFrameUsage& usage);
   void close();
 
  private:
-  std::filesystem::path path_, temp_;
+  io::AtomicFile file_;
   double refresh_hz_;
-  std::ofstream out_;
   bool closed_ = false;
 };
 void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz);

@@ -2,6 +2,8 @@
 // magic, version and a metadata text, then the packet stream as sent, then an end record.
 #pragma once
 
+#include "trm/atomic_file.hpp"
+
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -28,9 +30,9 @@ class CaptureError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Writes a capture to a temporary name beside `path`; close() writes the end record and renames it into
-// place, so an interrupted run never leaves a file that looks complete. Destroying an unclosed writer
-// removes the temporary file. Throws CaptureError on I/O failure.
+// Writes a capture through io::AtomicFile (a staging name beside `path`); close() writes the end record and
+// renames it into place, so an interrupted run never leaves a file that looks complete. Destroying an unclosed
+// writer removes the staging file. Throws CaptureError on I/O failure or a target that is not a regular file.
 class CaptureWriter {
  public:
   // `metadata` is free text stored verbatim (`trm run` writes its configuration as JSON).
@@ -44,9 +46,10 @@ class CaptureWriter {
   std::uint64_t packets_written() const { return packets_; }
 
  private:
+  void write(std::span<const std::uint8_t> bytes);
+
   std::filesystem::path path_;
-  std::filesystem::path temp_path_;
-  std::ofstream out_;
+  std::unique_ptr<io::AtomicFile> file_;
   std::uint64_t packets_ = 0;
   std::uint64_t packet_bytes_ = 0;
   bool closed_ = false;

@@ -2,21 +2,30 @@
 
 #include "rig/protocol.hpp"
 
-#include <cerrno>
-#include <cstring>
-
 namespace trm::rig {
 
 FileTransport::FileTransport(FileTransportOptions options) : options_(std::move(options)) {
   if (options_.framing == FileTransportOptions::Framing::Hid) options_.hid.validate();
   else if (options_.bulk_packet_size < kMinPacketSize || options_.bulk_packet_size > kChunkHeaderSize + kMaxChunkData)
     throw std::invalid_argument("bulk packet size must be 64.." + std::to_string(kChunkHeaderSize + kMaxChunkData));
-  file_ = std::fopen(options_.path.c_str(), "wb");
-  if (!file_) throw RigError(RigErrorKind::Io, "cannot create '" + options_.path + "': " + std::strerror(errno));
+  try {
+    file_ = std::make_unique<io::AtomicFile>(options_.path);
+  } catch (const std::runtime_error& e) {
+    throw RigError(RigErrorKind::Io, e.what());
+  }
 }
 
-FileTransport::~FileTransport() {
-  if (file_) std::fclose(file_);
+FileTransport::~FileTransport() = default;  // unfinished: the staging file is removed
+
+void FileTransport::finish() {
+  if (!file_) return;
+  try {
+    file_->commit();
+  } catch (const std::runtime_error& e) {
+    file_.reset();
+    throw RigError(RigErrorKind::Io, e.what());
+  }
+  file_.reset();
 }
 
 std::string FileTransport::description() const {
@@ -44,9 +53,13 @@ void FileTransport::send(std::span<const std::uint8_t> packet) {
   } else if (packet.size() > options_.bulk_packet_size) {
     throw std::invalid_argument("packet larger than the bulk packet size");
   }
-  // Flushed per packet so that what was written before an error is on disk, as on a device.
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size() || std::fflush(file_) != 0)
-    throw RigError(RigErrorKind::Io, "writing '" + options_.path + "' failed: " + std::strerror(errno));
+  if (!file_) throw RigError(RigErrorKind::Io, "'" + options_.path + "' is already finished or failed");
+  try {
+    file_->write(bytes);
+  } catch (const std::runtime_error& e) {
+    file_.reset();  // the staging file is gone
+    throw RigError(RigErrorKind::Io, e.what());
+  }
 }
 
 }  // namespace trm::rig

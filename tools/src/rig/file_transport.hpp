@@ -1,11 +1,15 @@
 // Writes exactly the bytes a device would receive, for offline rigs and for diffing against a capture:
 // stream framing = the concatenated bulk OUT data; HID framing = one wire report after another.
+// Written through io::AtomicFile: the file appears by finish() only, so a failed feed (bad argument, full
+// disk, interrupt) leaves no file behind.
 #pragma once
 
 #include "rig/hid_report.hpp"
 #include "rig/transport.hpp"
 
-#include <cstdio>
+#include "trm/atomic_file.hpp"
+
+#include <memory>
 #include <string>
 
 namespace trm::rig {
@@ -21,6 +25,7 @@ class FileTransport final : public RigTransport {
  public:
   explicit FileTransport(FileTransportOptions options);  // throws RigError(Io) when it cannot create the file
   ~FileTransport() override;
+  void finish() override;  // throws RigError(Io)
 
   std::string description() const override;
   std::size_t max_packet_size() const override;
@@ -32,7 +37,7 @@ class FileTransport final : public RigTransport {
 
  private:
   FileTransportOptions options_;
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<io::AtomicFile> file_;
 };
 
 }  // namespace trm::rig

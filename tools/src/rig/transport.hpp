@@ -64,6 +64,8 @@ class RigTransport {
   // One answer from the rig, or nullopt when none arrived within `timeout` (may return early).
   virtual std::optional<std::vector<std::uint8_t>> receive(std::chrono::milliseconds timeout) = 0;
   virtual TransportRate nominal_rate() const = 0;
+  // After the last view of a successful feed: a file transport moves its file into place (nothing before).
+  virtual void finish() {}
 };
 
 // "1234:5678" (hex) -> {0x1234, 0x5678}; throws std::invalid_argument with the expected form.
