@@ -7,6 +7,7 @@
 #include "trm_process.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -94,6 +95,11 @@ class BadInput : public ::testing::Test {
     fixtures_ = std::make_unique<ScratchDir>("trm-bad-input-fixtures-");
     const fs::path f = fixtures_->path();
     std::ofstream(f / "not_a_hid") << "a regular file\n";
+    ASSERT_EQ(::mkfifo((f / "fifo").c_str(), 0600), 0);
+    fs::create_symlink(f / "not_a_hid", f / "symlink");
+    fs::create_directories(f / "project");
+    std::ofstream(f / "project" / "report.json") << "{\"mine\": true}\n";  // a user's file, not a trm output
+    std::ofstream(f / "project" / "main.cpp") << "int main() {}\n";
     fs::create_directories(f / "frames_dir");
     for (const bool stereo : {false, true}) {
       const std::string name = stereo ? "stereo" : "mono";
@@ -252,6 +258,23 @@ TEST_F(BadInput, CaptureMetadataTheCommandLineWouldReject) {
       {"decode --capture {f}/beyond_frames.trmcap --out o", "beyond the 3 frames"},
       {"decode --capture {f}/no_frames.trmcap --out o", "no frame that arrived"},
       {"feed --capture {f}/says_mono.trmcap --file o.bin", "mono"},
+  };
+  for (const Case& c : cases) expect_clean_failure(c.args, c.fragment);
+}
+
+// Outputs go onto a regular file or a new name only, and never replace what trm did not write.
+TEST_F(BadInput, OutputsThatWouldClobber) {
+  const std::vector<Case> cases = {
+      {"run --size 8x8 --frames 2 --link dp1.4 --capture-out {f}/fifo --out o", "fifo"},
+      {"run --size 8x8 --frames 2 --link dp1.4 --capture-out {f}/symlink --out o", "symlink"},
+      {"hw-report --json {f}/fifo", "fifo"},
+      {"hw-report --json {f}/frames_dir", "frames_dir"},
+      {"vectors --update-golden {f}/fifo", "fifo"},
+      {"run --size 8x8 --frames 2 --out {f}/project", "project"},
+      {"run --size 8x8 --frames 2 --out {f}/not_a_hid", "not_a_hid"},
+      {"feed --size 8x8 --frames 2 --file {f}/fifo", "fifo"},
+      {"feed --size 8x8 --frames 2 --file o.bin --summary /nonexistent/s.json", "/nonexistent/s.json"},
+      {"feed --size 8x8 --frames 2 --file o.bin --summary {f}/fifo", "fifo"},
   };
   for (const Case& c : cases) expect_clean_failure(c.args, c.fragment);
 }
