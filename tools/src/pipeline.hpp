@@ -7,6 +7,7 @@
 #include "trm/link_simulation.hpp"
 #include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
+#include "view_size.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -80,9 +81,6 @@ struct DecodedView {
   double encode_seconds = 0.0;
   double decode_seconds = 0.0;
 };
-
-// "WxH" with W, H >= 1; throws CLI::ValidationError naming `option` otherwise.
-cv::Size parse_view_size(const std::string& text, const std::string& option = "--size");
 
 struct LinkOutcome {
   std::vector<link::LinkFrameUsage> frames;
