@@ -1,0 +1,64 @@
+// Shared by the libFuzzer targets: the finding rule (abort on a broken invariant or on an exception
+// outside the error contract) and a private scratch directory for targets that must go through a file.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <typeinfo>
+
+namespace trm::fuzz {
+
+// A broken invariant: abort, so libFuzzer keeps the input as a crash artifact.
+inline void check(bool condition, const char* what) {
+  if (!condition) {
+    std::fprintf(stderr, "fuzz invariant broken: %s\n", what);
+    std::abort();
+  }
+}
+
+// An exception the error contract does not allow (the parser must throw its documented type with a
+// message): report what escaped and abort.
+[[noreturn]] inline void unexpected_exception(const char* target) {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: unexpected exception %s: %s\n", target, typeid(e).name(), e.what());
+  } catch (...) {
+    std::fprintf(stderr, "%s: unexpected non-standard exception\n", target);
+  }
+  std::abort();
+}
+
+// A per-process directory under $TMPDIR, removed at exit.
+inline const std::filesystem::path& scratch_dir() {
+  static const std::filesystem::path dir = [] {
+    const char* tmp = std::getenv("TMPDIR");
+    std::filesystem::path d = std::filesystem::path(tmp && *tmp ? tmp : "/tmp") /
+                              ("trm-fuzz-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    std::atexit([] {
+      std::error_code ignored;
+      std::filesystem::remove_all(scratch_dir(), ignored);
+    });
+    return d;
+  }();
+  return dir;
+}
+
+inline std::filesystem::path write_scratch_file(const std::string& name, const std::uint8_t* data, std::size_t size) {
+  const std::filesystem::path path = scratch_dir() / name;
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  out.close();
+  check(static_cast<bool>(out), "cannot write the scratch file");
+  return path;
+}
+
+}  // namespace trm::fuzz
