@@ -4,6 +4,8 @@
 // videos written by OpenCV in the formats it can write here.
 //
 // Usage: make_seeds OUTPUT_DIR
+#include "rig/protocol.hpp"
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -51,6 +53,38 @@ void write_rig_answers(const fs::path& dir) {
   write(dir / "too_many_resends", config + resend + resend + resend);
   write(dir / "short_and_foreign", config + std::string("\x01\x03\x81\x00\x00", 5) + answer(1, 0x42, 0) + ready);
   write(dir / "one_pixel_8bit", std::string{'\x00', '\x00', '\x07', '\x3f', '\x00', '\x00'} + ready);
+}
+
+// fuzz_rig_stream: what the feeder writes for a few frames, as one byte stream.
+void write_rig_streams(const fs::path& dir) {
+  using namespace trm::rig;
+  fs::create_directories(dir);
+  const auto frame = [](std::int64_t index, int width, int height, int bits) {
+    RigFrame f;
+    f.index = index;
+    f.width = width;
+    f.height = height;
+    f.bits = bits;
+    for (int i = 0; i < width * height * 3; ++i) f.samples.push_back(static_cast<std::uint16_t>((i * 37) & ((1 << bits) - 1)));
+    return f;
+  };
+  const auto append = [](std::string& out, const std::vector<std::uint8_t>& packet) { out.append(packet.begin(), packet.end()); };
+  const auto stream = [&](const std::vector<RigFrame>& frames, std::size_t packet_size, bool resend) {
+    std::string out;
+    for (const RigFrame& f : frames) {
+      const EncodedFrame e = encode_frame(f, packet_size, false);
+      append(out, e.start_packet);
+      for (std::uint32_t s = 0; s < e.chunk_count(); ++s) append(out, e.chunk_packet(s));
+      if (resend && e.chunk_count() > 1)  // a rewind to chunk 1, as after a RESEND
+        for (std::uint32_t s = 1; s < e.chunk_count(); ++s) append(out, e.chunk_packet(s));
+      append(out, e.end_packet);
+    }
+    return out;
+  };
+  write(dir / "mono_8bit", stream({frame(0, 4, 3, 8)}, 64, false));
+  write(dir / "two_frames_10bit", stream({frame(5, 5, 4, 10), frame(6, 5, 4, 10)}, 64, false));
+  write(dir / "rewind", stream({frame(9, 6, 5, 12)}, 72, true));
+  write(dir / "one_pixel_1bit", stream({frame(1, 1, 1, 1)}, 64, false));
 }
 
 cv::Mat pattern(int width, int height, int type) {
@@ -152,6 +186,7 @@ int main(int argc, char** argv) {
     write_texts(out / "view_size", {"1080x1200", "1x1", "64X48", "0x5", "10x", "x10", "10x10x", "-3x4", " 8x 8",
                                     "2147483647x2147483647", "12y12"});
     write_rig_answers(out / "rig_answers");
+    write_rig_streams(out / "rig_stream");
     write_images(out / "image");
     write_videos(out / "video");
   } catch (const std::exception& e) {
