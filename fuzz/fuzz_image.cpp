@@ -37,5 +37,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (...) {
     trm::fuzz::unexpected_exception("fuzz_image");
   }
+  trm::fuzz::close_leaked_descriptors(path);
   return 0;
 }
