@@ -185,6 +185,11 @@ int main(int argc, char** argv) {
                                 "gamma:0", "gamma:1,2", "lcd:1,2,3,4", "gamma:inf", "lcd:0,0,0,0,1"});
     write_texts(out / "view_size", {"1080x1200", "1x1", "64X48", "0x5", "10x", "x10", "10x10x", "-3x4", " 8x 8",
                                     "2147483647x2147483647", "12y12"});
+    // fuzz_options: first byte even: --burst, odd: VID:PID.
+    write_texts(out / "options", {std::string("\x00") + "1e-7:64", std::string("\x00") + "0:1", std::string("\x00") + "1:1000000",
+                                  std::string("\x00") + "0.5:0", std::string("\x00") + "1e-7", std::string("\x01") + "1234:5678",
+                                  std::string("\x01") + "0x1d6b:0X0002", std::string("\x01") + "abcd:12345",
+                                  std::string("\x01") + "1234"});
     write_rig_answers(out / "rig_answers");
     write_rig_streams(out / "rig_stream");
     write_images(out / "image");

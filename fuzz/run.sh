@@ -3,26 +3,29 @@
 # generates their seed corpora, fuzzes each for a bounded time and prints, per target, the executions,
 # the corpus size and the findings (docs/fuzzing.md).
 #
-# Usage: fuzz/run.sh SECONDS [TARGET...]
-#   SECONDS   fuzzing time of the whole run (wall clock, build excluded), shared evenly by the targets;
-#             with TRM_FUZZ_JOBS targets at a time each gets SECONDS * JOBS / TARGETS (at least 1 s)
-#   TARGET    only these (default: all): receiver capture rig_answers rig_stream panel link_preset view_size image video
-# Environment: TRM_FUZZ_BUILD_DIR (default: $TMPDIR/trm-fuzz-build), CXX (default: clang++),
-#   TRM_FUZZ_JOBS (compiles and fuzzers at a time, default 2), TRM_FUZZ_EXTRA_SEEDS (a directory of more
-#   .trmcap seeds for the receiver and capture targets, e.g. written by `trm run --capture-out`).
+# Usage: fuzz/run.sh SECONDS [EXTRA_SEED_DIR...]
+#   SECONDS          fuzzing time of the whole run (wall clock, build excluded), shared evenly by the
+#                    targets: with TRM_FUZZ_JOBS targets at a time each gets SECONDS * JOBS / TARGETS
+#                    (at least 1 s, at most SECONDS)
+#   EXTRA_SEED_DIR   more .trmcap seeds for the receiver and capture targets, e.g. a directory of captures
+#                    written by `trm run --capture-out`
+# Environment: TRM_FUZZ_TARGETS (default: all of receiver capture rig_answers rig_stream panel
+#   link_preset view_size options image video), TRM_FUZZ_JOBS (compiles and fuzzers at a time, default
+#   2), TRM_FUZZ_BUILD_DIR (default: $TMPDIR/trm-fuzz-build), CXX (default: clang++).
 # Exit status: 0 when every target ends without a finding; 1 on any crash, sanitizer report, leak,
 # timeout or out-of-memory (the reproducer is left under artifacts/TARGET/ in the build directory).
 set -euo pipefail
+{  # read whole before it runs: editing the script during a long run cannot derail it
 
-all_targets=(receiver capture rig_answers rig_stream panel link_preset view_size image video)
+all_targets=(receiver capture rig_answers rig_stream panel link_preset view_size options image video)
 if [[ $# -lt 1 || ! "$1" =~ ^[0-9]+$ || "$1" -lt 1 ]]; then
-  echo "usage: $0 SECONDS [TARGET...]   (targets: ${all_targets[*]})" >&2
+  echo "usage: $0 SECONDS [EXTRA_SEED_DIR...]   (TRM_FUZZ_TARGETS: ${all_targets[*]})" >&2
   exit 2
 fi
 seconds=$1
 shift
-targets=("$@")
-((${#targets[@]})) || targets=("${all_targets[@]}")
+extra=("$@")
+read -r -a targets <<<"${TRM_FUZZ_TARGETS:-${all_targets[*]}}"
 for t in "${targets[@]}"; do
   [[ " ${all_targets[*]} " == *" $t "* ]] || { echo "$0: unknown target '$t' (targets: ${all_targets[*]})" >&2; exit 2; }
 done
@@ -90,8 +93,6 @@ rm -rf "$build/seeds"
 "$build/make_corpus" "$build/seeds/receiver"
 cp -r "$build/seeds/receiver" "$build/seeds/capture"
 "$build/make_seeds" "$build/seeds"
-extra=()
-[[ -n "${TRM_FUZZ_EXTRA_SEEDS:-}" ]] && extra=("$TRM_FUZZ_EXTRA_SEEDS")
 
 per_target=$((seconds * jobs / ${#targets[@]}))
 ((per_target >= 1)) || per_target=1
@@ -109,7 +110,7 @@ run_target() {  # TARGET
     # scan after nearly every input, 25 times slower: -detect_leaks=0 leaves the leak check to the end of
     # the run, where LeakSanitizer still reports (and fails the target on) any leak of the whole run.
     image | video) max_len=16384; more=(-close_fd_mask=2 -detect_leaks=0) ;;
-    panel | link_preset | view_size) max_len=256 ;;
+    panel | link_preset | view_size | options) max_len=256 ;;
   esac
   mkdir -p "$build/corpus/$t" "$build/artifacts/$t"
   rm -f "$build/artifacts/$t"/*
@@ -147,3 +148,5 @@ if ((failed)); then
   echo "fuzzing found something: the logs are in $build/logs, the reproducers under $build/artifacts" >&2
   exit 1
 fi
+exit 0
+}
