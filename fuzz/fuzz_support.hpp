@@ -36,17 +36,14 @@ inline void check(bool condition, const char* what) {
   std::abort();
 }
 
-// A per-process directory under $TMPDIR, removed at exit.
+// A per-process directory under $TMPDIR. libFuzzer ends a run without the atexit handlers, so it is
+// not removed here: fuzz/run.sh points TMPDIR at a directory of its own for each target and clears it.
 inline const std::filesystem::path& scratch_dir() {
   static const std::filesystem::path dir = [] {
     const char* tmp = std::getenv("TMPDIR");
     std::filesystem::path d = std::filesystem::path(tmp && *tmp ? tmp : "/tmp") /
                               ("trm-fuzz-" + std::to_string(::getpid()));
     std::filesystem::create_directories(d);
-    std::atexit([] {
-      std::error_code ignored;
-      std::filesystem::remove_all(scratch_dir(), ignored);
-    });
     return d;
   }();
   return dir;

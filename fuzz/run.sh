@@ -114,10 +114,12 @@ run_target() {  # TARGET
   esac
   mkdir -p "$build/corpus/$t" "$build/artifacts/$t"
   rm -f "$build/artifacts/$t"/*
+  rm -rf "$build/tmp/$t" && mkdir -p "$build/tmp/$t"  # the targets' scratch files (fuzz_support.hpp)
   local status=0
-  "$build/fuzz_$t" "$build/corpus/$t" "$build/seeds/$t" "${more[@]}" \
+  TMPDIR="$build/tmp/$t" "$build/fuzz_$t" "$build/corpus/$t" "$build/seeds/$t" "${more[@]}" \
     -max_total_time="$per_target" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" \
     -artifact_prefix="$build/artifacts/$t/" -print_final_stats=1 >"$build/logs/$t.log" 2>&1 || status=$?
+  rm -rf "$build/tmp/$t"
   echo "$status" >"$build/logs/$t.status"
 }
 for t in "${targets[@]}"; do
