@@ -6,7 +6,6 @@
 #include "opencv_limits.hpp"
 #include "trm/scene.hpp"
 
-#include <cmath>
 #include <stdexcept>
 #include <string>
 

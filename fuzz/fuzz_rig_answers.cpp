@@ -16,7 +16,6 @@
 #include "rig/transport.hpp"
 
 #include <algorithm>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
