@@ -110,6 +110,14 @@ TEST_F(SourceTest, NonImageFilesNameTheOffendingFile) {
   expect_error_naming<std::runtime_error>([&] { open_image_sequence(path("n_*.png")); }, "n_2.png");
 }
 
+// Found by fuzz/fuzz_image.cpp: OpenCV hands a file with the DICOM signature to GDCM, which aborted the
+// process (a failed assertion) on this 132-byte file instead of failing the read.
+TEST_F(SourceTest, DicomFilesAreRefusedBeforeOpenCvAbortsOnThem) {
+  std::ofstream(path("d_1.png"), std::ios::binary) << std::string(128, '\0') << "DICM";
+  expect_error_naming<std::runtime_error>([&] { open_image_sequence(path("d_1.png")); }, "d_1.png");
+  expect_error_naming<std::runtime_error>([&] { open_image_sequence(path("d_1.png")); }, "DICOM");
+}
+
 TEST_F(SourceTest, VideoFramesAreReadInAnyOrder) {
   const std::string file = path("clip.avi");
   cv::VideoWriter writer(file, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0, cv::Size(32, 16));

@@ -99,6 +99,52 @@ TEST(RigProtocol, ReceiverRejectsCorruption) {
   EXPECT_THROW(receive_stream(header), std::runtime_error);
 }
 
+// Found by fuzz/fuzz_rig_stream.cpp: a FRAME_START with a valid CRC but 0 bytes per sample and an empty
+// payload reached a division by zero at FRAME_END; other header values the CRC does not vouch for gave
+// frames that are not valid RigFrames. The reference receiver now rejects them at FRAME_START.
+TEST(RigProtocol, ReceiverRejectsFrameStartsDescribingNoValidFrame) {
+  FrameStart empty;
+  empty.frame_index = 3;
+  empty.width = empty.height = 1;
+  empty.bytes_per_sample = 0;  // with payload length, chunk count and payload CRC 0 (crc32 of nothing)
+  {
+    StreamReceiver receiver;
+    EXPECT_THROW(receiver.accept_packet(encode_frame_start(empty)), std::runtime_error);
+    EXPECT_THROW(receiver.accept_packet(encode_frame_end(FrameEnd{0, 3, 0})), std::runtime_error);  // no frame open
+    EXPECT_TRUE(receiver.frames().empty());
+  }
+
+  const RigFrame frame = synthetic_frame(7, 0, 4, 3, 10);
+  const EncodedFrame good = encode_frame(frame, 64, false);
+  const auto rejected = [&](auto&& edit) {
+    FrameStart s = good.start;
+    edit(s);
+    StreamReceiver receiver;
+    EXPECT_THROW(receiver.accept_packet(encode_frame_start(s)), std::runtime_error);
+  };
+  rejected([](FrameStart& s) { s.bits = 0; });
+  rejected([](FrameStart& s) { s.bits = 17; });
+  rejected([](FrameStart& s) { s.bytes_per_sample = 1; });         // 10 bits in one byte
+  rejected([](FrameStart& s) { s.channel_order = ChannelOrder{1}; });
+  rejected([](FrameStart& s) { s.width = 0; });
+  rejected([](FrameStart& s) { s.width = 5; });                    // payload length no longer 4 x 3 x 3 x 2
+  rejected([](FrameStart& s) { s.payload_length = 0xFFFFFFF0u; });  // would have reserved 4 GB
+  rejected([](FrameStart& s) { s.step = 0; });
+  rejected([](FrameStart& s) { s.region_x = 0x80000000u; });
+
+  // Codes wider than the bits the header states: rejected at FRAME_END, once the payload is known.
+  FrameStart narrow = good.start;
+  narrow.bits = 9;
+  StreamReceiver receiver;
+  receiver.accept_packet(encode_frame_start(narrow));
+  for (std::uint32_t s = 0; s < good.chunk_count(); ++s) receiver.accept_packet(good.chunk_packet(s));
+  EXPECT_THROW(receiver.accept_packet(good.end_packet), std::runtime_error);
+  EXPECT_TRUE(receiver.frames().empty());
+
+  // The unedited frame still goes through.
+  EXPECT_EQ(receive_stream(expected_stream({frame}, 64, false)).size(), 1u);
+}
+
 TEST(RigProtocol, AnswersRoundTrip) {
   const Answer a{AnswerKind::Resend, 0, 17, -3};
   const auto bytes = encode_answer(a);

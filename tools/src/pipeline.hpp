@@ -7,6 +7,7 @@
 #include "trm/link_simulation.hpp"
 #include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
+#include "view_size.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -81,18 +82,10 @@ struct DecodedView {
   double decode_seconds = 0.0;
 };
 
-// "WxH" with 1 <= W, H <= kMaxViewSide (trm/frame.hpp); throws CLI::ValidationError naming `option` otherwise.
-cv::Size parse_view_size(const std::string& text, const std::string& option = "--size");
-
 // Option checks with exact messages: a whole number >= `lowest`, and a finite number >= 0. `meaning` follows the
 // rule in the message (e.g. "; leave --frames out for every input frame").
 CLI::Validator whole_number_at_least(long long lowest, const std::string& meaning = "");
 CLI::Validator finite_non_negative(const std::string& meaning = "");
-
-// Exactly `count` decimal ints separated by `separator` (nothing else, no wrap-around: out-of-range values are an
-// error); throws CLI::ValidationError naming `option` and what was `expected`.
-std::vector<int> parse_int_list(const std::string& text, std::size_t count, const std::string& option,
-                                const std::string& expected, char separator = ',');
 
 struct LinkOutcome {
   link::BandwidthSummary summary;  // per-frame usage goes to run_pipeline's link_sink as it happens

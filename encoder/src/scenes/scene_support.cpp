@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
@@ -260,9 +262,20 @@ cv::Mat linearise_integer(const cv::Mat& img, const std::vector<double>& lut) {
   return out;
 }
 
+// OpenCV gives a file with "DICM" at byte 128 (the DICOM signature) to its GDCM decoder, and GDCM aborts
+// the whole process on a failed assertion when such a file is malformed (found by fuzz/fuzz_image.cpp:
+// 128 zero bytes and "DICM" are enough). No headset content is DICOM, so such files are refused first.
+bool has_dicom_signature(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[132];
+  return in.read(head, sizeof head) && std::memcmp(head + 128, "DICM", 4) == 0;
+}
+
 }  // namespace
 
 cv::Mat load_linear_image(const std::string& path) {
+  if (has_dicom_signature(path))
+    throw std::runtime_error("image '" + path + "' is a DICOM file (\"DICM\" at byte 128); DICOM images are not supported");
   cv::Mat img;
   try {
     img = cv::imread(path, cv::IMREAD_UNCHANGED);

@@ -35,6 +35,28 @@ std::int64_t get_i64(const std::uint8_t* p) {
 
 [[noreturn]] void malformed(const std::string& what) { throw std::runtime_error("rig protocol: " + what); }
 
+// What a rig checks in a FRAME_START beyond its CRC and version, so that the frame it reassembles is a
+// valid RigFrame: RGB order, 1..16 bits in the bytes per sample they take, a size of at least 1x1 whose
+// width x height x 3 x bytes per sample is the payload length, a step of at least 1, view and region
+// fields that fit an int.
+void check_frame_start(const FrameStart& s) {
+  if (s.channel_order != ChannelOrder::Rgb)
+    malformed("FRAME_START channel order " + std::to_string(static_cast<int>(s.channel_order)) + " is not RGB (0)");
+  if (s.bits < 1 || s.bits > 16) malformed("FRAME_START bits per channel " + std::to_string(s.bits) + " outside 1..16");
+  if (s.bytes_per_sample != (s.bits <= 8 ? 1 : 2))
+    malformed("FRAME_START bytes per sample " + std::to_string(s.bytes_per_sample) + " does not match " +
+              std::to_string(s.bits) + " bits");
+  if (s.width < 1 || s.height < 1 || s.width > std::numeric_limits<int>::max() || s.height > std::numeric_limits<int>::max())
+    malformed("FRAME_START size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " out of range");
+  const std::uint64_t pixels = static_cast<std::uint64_t>(s.width) * s.height;  // < 2^62
+  if (pixels > s.payload_length || pixels * 3u * s.bytes_per_sample != s.payload_length)
+    malformed("FRAME_START payload length " + std::to_string(s.payload_length) + " is not width x height x 3 x " +
+              std::to_string(s.bytes_per_sample));
+  if (s.step < 1) malformed("FRAME_START step 0");
+  for (std::uint32_t v : {s.view_width, s.view_height, s.region_x, s.region_y})
+    if (v > static_cast<std::uint32_t>(std::numeric_limits<int>::max())) malformed("FRAME_START view or region field out of range");
+}
+
 std::uint32_t checked_u32(std::size_t v, const char* what) {
   if (v > std::numeric_limits<std::uint32_t>::max()) throw std::invalid_argument(std::string(what) + " too large");
   return static_cast<std::uint32_t>(v);
@@ -300,9 +322,12 @@ void StreamReceiver::accept_packet(std::span<const std::uint8_t> packet) {
   switch (static_cast<PacketType>(packet[0])) {
     case PacketType::FrameStart: {
       if (open_) malformed("FRAME_START while frame " + std::to_string(open_->frame_index) + " is open");
-      open_ = decode_frame_start(packet);
+      const FrameStart start = decode_frame_start(packet);
+      check_frame_start(start);
+      open_ = start;
       payload_.clear();
-      payload_.reserve(open_->payload_length);
+      // Grown as chunks arrive beyond this: a corrupt length cannot make the receiver allocate gigabytes.
+      payload_.reserve(std::min<std::size_t>(open_->payload_length, std::size_t{1} << 24));
       next_sequence_ = 0;
       return;
     }
@@ -340,8 +365,11 @@ void StreamReceiver::accept_packet(std::span<const std::uint8_t> packet) {
       f.region_y = static_cast<int>(open_->region_y);
       f.step = open_->step;
       f.samples.resize(payload_.size() / open_->bytes_per_sample);
-      for (std::size_t i = 0; i < f.samples.size(); ++i)
+      const auto max_code = static_cast<std::uint16_t>((1u << open_->bits) - 1u);
+      for (std::size_t i = 0; i < f.samples.size(); ++i) {
         f.samples[i] = open_->bytes_per_sample == 1 ? payload_[i] : get_u16(&payload_[2 * i]);
+        if (f.samples[i] > max_code) malformed("a drive code exceeds " + std::to_string(open_->bits) + " bits");
+      }
       frames_.push_back(std::move(f));
       open_.reset();
       return;
