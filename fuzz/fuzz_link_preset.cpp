@@ -17,6 +17,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const trm::link::LinkPreset p = trm::link::parse_link_preset(text);
     check(p.name == text, "preset name differs from the text");
     check(std::isfinite(p.raw_gbps) && p.raw_gbps > 0.0, "rate not finite and > 0");
+    check(p.data_gbps() <= trm::link::kMaxLinkGbps, "data rate beyond kMaxLinkGbps");
     check(p.efficiency > 0.0 && p.efficiency <= 1.0, "efficiency outside (0, 1]");
     check(!p.description.empty(), "no description");
   } catch (const std::invalid_argument& e) {

@@ -85,26 +85,28 @@ std::string gigabytes(double bytes) {
   return text.str();
 }
 
-void require_memory_for(const PipelineOptions& options, cv::Size view) {
-  const std::optional<double> available = available_memory_bytes();
-  if (!available) return;  // no /proc: nothing to compare with
-  const bool lcd = parse_panel(options.panel).kind == PanelKind::Lcd;
-  const double per_pixel = (lcd ? kRunBytesPerPixelLcd : kRunBytesPerPixelOled) *
-                           (options.encoder.stereo ? kRunStereoFactor : 1.0);
-  const double needed = kRunBaseBytes + per_pixel * static_cast<double>(view.width) * view.height;
-  if (needed > *available) {
-    throw std::runtime_error("a " + std::to_string(view.width) + "x" + std::to_string(view.height) + " view needs about " +
-                             gigabytes(needed) + " of memory (about " + std::to_string(static_cast<int>(per_pixel)) +
-                             " B per pixel with this panel" + (options.encoder.stereo ? " in stereo" : "") +
-                             "), but only " + gigabytes(*available) + " is available: use a smaller --size");
-  }
-}
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
+
+double run_bytes_per_pixel(const PipelineOptions& options) {
+  const bool lcd = parse_panel(options.panel).kind == PanelKind::Lcd;
+  return (lcd ? kRunBytesPerPixelLcd : kRunBytesPerPixelOled) * (options.encoder.stereo ? kRunStereoFactor : 1.0);
+}
+
+void require_memory(const std::string& what, double bytes_per_pixel, cv::Size view) {
+  const std::optional<double> available = available_memory_bytes();
+  if (!available) return;  // no /proc: nothing to compare with
+  const double needed = kRunBaseBytes + bytes_per_pixel * static_cast<double>(view.width) * view.height;
+  if (needed > *available) {
+    throw std::runtime_error("a " + std::to_string(view.width) + "x" + std::to_string(view.height) + " view needs about " +
+                             gigabytes(needed) + " of memory (about " +
+                             std::to_string(static_cast<long long>(bytes_per_pixel)) + " B per pixel " + what +
+                             "), but only " + gigabytes(*available) + " is available: use a smaller --size");
+  }
+}
 
 CLI::Validator whole_number_at_least(long long lowest, const std::string& meaning) {
   return CLI::Validator(
@@ -283,7 +285,8 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
                             const std::function<void(const link::LinkFrameUsage&)>& link_sink) {
   options.validate();
   const std::unique_ptr<FrameSource> source = options.open_source();
-  require_memory_for(options, cv::Size(source->width(), source->height()));
+  require_memory(std::string("with this panel") + (options.encoder.stereo ? " in stereo" : ""),
+                 run_bytes_per_pixel(options), cv::Size(source->width(), source->height()));
 
   std::int64_t frames = options.frames;
   const auto available = source->frame_count();

@@ -82,6 +82,12 @@ struct DecodedView {
   double decode_seconds = 0.0;
 };
 
+// Peak memory of a pipeline run per pixel of the view (measured; see pipeline.cpp), and the check every command that
+// allocates per pixel makes before it starts: throws std::runtime_error saying how much the view needs and how much
+// this machine has (MemAvailable) when about 100 MB + bytes_per_pixel W H does not fit.
+double run_bytes_per_pixel(const PipelineOptions& options);
+void require_memory(const std::string& what, double bytes_per_pixel, cv::Size view);
+
 // Option checks with exact messages: a whole number >= `lowest`, and a finite number >= 0. `meaning` follows the
 // rule in the message (e.g. "; leave --frames out for every input frame").
 CLI::Validator whole_number_at_least(long long lowest, const std::string& meaning = "");

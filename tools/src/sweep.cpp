@@ -134,6 +134,10 @@ std::string not_applicable(const SweepKnob& knob, PanelKind kind, ResampleSpace 
   return "";
 }
 
+// One recorded view per pixel: link codes and drive codes (CV_16UC3, 6 B each), drive and emitted light
+// (CV_64FC3, 24 B each).
+constexpr double kRecordedViewBytesPerPixel = 6.0 + 6.0 + 24.0 + 24.0;
+
 // The reference's output of one view, and the view as sent.
 struct RecordedView {
   LinkFrame sent;
@@ -515,6 +519,12 @@ void SweepOptions::validate() const {
   if (repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
   if (hw_size.width < 1 || hw_size.height < 1) throw std::invalid_argument("--hw-size must be WxH with W, H >= 1");
   pipeline.validate();
+  // The recording keeps every view's codes, drive codes, drive and emitted light beside a pipeline run.
+  const std::int64_t frames = pipeline.frames > 0 ? pipeline.frames : pipeline.default_frames;
+  const std::int64_t views = frames * (pipeline.encoder.stereo ? 2 : 1);
+  require_memory("for the pipeline and " + std::to_string(views) + " recorded views",
+                 run_bytes_per_pixel(pipeline) + kRecordedViewBytesPerPixel * static_cast<double>(views),
+                 cv::Size(pipeline.width, pipeline.height));
 }
 
 const SweepPoint* SweepKnobResult::cheapest_meeting() const {
