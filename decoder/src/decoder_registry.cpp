@@ -33,13 +33,21 @@ const std::vector<std::string>& decoder_names() {
   return names;
 }
 
-std::unique_ptr<HeadsetDecoder> make_decoder(const std::string& name, const FixedDecoderConfig& config) {
-  for (const auto& [known, factory] : registry()) {
-    if (known == name) return factory(config);
+void check_decoder_name(const std::string& name) {
+  for (const std::string& known : decoder_names()) {
+    if (known == name) return;
   }
   std::string list;
   for (const std::string& known : decoder_names()) list += (list.empty() ? "" : ", ") + known;
   throw std::invalid_argument("unknown decoder implementation '" + name + "' (available: " + list + ")");
+}
+
+std::unique_ptr<HeadsetDecoder> make_decoder(const std::string& name, const FixedDecoderConfig& config) {
+  check_decoder_name(name);
+  for (const auto& [known, factory] : registry()) {
+    if (known == name) return factory(config);
+  }
+  return nullptr;  // not reached: check_decoder_name threw
 }
 
 }  // namespace trm

@@ -249,6 +249,7 @@ TEST_F(BadInput, InputsThatAreNotInputs) {
       {"run --input {f}/missing.mp4 --frames 2", "does not exist"},
       {"run --input '{f}/frames_dir/*.png'", "frames_dir"},
       {"run --scene nosuch --size 8x8 --frames 2", "nosuch"},
+      {"run --impl nosuch --size 8x8 --frames 2", "--impl"},
       {"decode --out o", "--input"},
       {"decode --capture {f}/missing.trmcap --out o", "missing.trmcap"},
       {"decode --capture {f}/not_a_hid --out o", "not_a_hid"},

@@ -6,8 +6,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -259,11 +257,10 @@ void PipelineOptions::validate() const {
   validate_refresh_hz(refresh_hz, "--refresh");
   if (frames < 0) throw std::invalid_argument("--frames must be >= 0");
   if (output_bits != 8 && output_bits != 10) throw std::invalid_argument("output bits must be 8 or 10");
-  const std::vector<std::string>& decoders = decoder_names();
-  if (std::find(decoders.begin(), decoders.end(), impl) == decoders.end()) {
-    std::string list;
-    for (const std::string& name : decoders) list += (list.empty() ? "" : ", ") + name;
-    throw std::invalid_argument("unknown decoder implementation --impl '" + impl + "' (available: " + list + ")");
+  try {
+    check_decoder_name(impl);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--impl: ") + e.what());
   }
   // The decoder's whole configuration, before any output exists: the fixed-point formats only for those decoders.
   const FixedDecoderConfig decoder_config = fixed_config_of(*this);
@@ -423,19 +420,21 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(where + "no readable configuration in its header: " + e.what());
   }
-  // The header is checked as strictly as the command line that wrote it.
-  DecoderConfig config;
+  // The link configuration comes from the header, checked as strictly as the command line that wrote it; panel,
+  // sensitivity, output bits and fixed-point formats come from the options.
+  PipelineOptions capture_options = options;
+  EncoderConfig& link = capture_options.encoder;
   std::optional<std::int64_t> frames_sent;
   try {
     if (!meta.is_object()) throw std::invalid_argument("the header's configuration is not a JSON object");
-    config.link.reduction = meta.at("reduction").get<double>();
-    config.link.sigma = meta.at("sigma").get<double>();
-    config.link.phase = meta.at("phase").get<int>();
-    config.link.transfer = parse_transfer(meta.at("transfer").get<std::string>());
-    config.link.resample_space = parse_resample_space(meta.at("resample_space").get<std::string>());
-    config.link.bits = meta.at("bits").get<int>();
-    config.link.stereo = meta.at("stereo").get<bool>();
-    config.link.validate();
+    link.reduction = meta.at("reduction").get<double>();
+    link.sigma = meta.at("sigma").get<double>();
+    link.phase = meta.at("phase").get<int>();
+    link.transfer = parse_transfer(meta.at("transfer").get<std::string>());
+    link.resample_space = parse_resample_space(meta.at("resample_space").get<std::string>());
+    link.bits = meta.at("bits").get<int>();
+    link.stereo = meta.at("stereo").get<bool>();
+    link.validate();
     validate_refresh_hz(meta.at("refresh_hz").get<double>(), "refresh_hz");
     if (meta.contains("frames")) {
       frames_sent = meta.at("frames").get<std::int64_t>();
@@ -446,20 +445,11 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + "invalid configuration in its header: " + e.what());
   }
-  config.sensitivity = options.sensitivity;
-  config.panel = parse_panel(options.panel);
-  config.output_bits = options.output_bits;
-  config.lcd_history = options.lcd_history;
-  // The selected implementation; the fixed-point ones take the capture's link configuration as well.
-  PipelineOptions capture_options = options;
-  capture_options.encoder = config.link;
-  FixedDecoderConfig decoder_config = fixed_config_of(capture_options);
-  decoder_config.decoder = config;
-  const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(options.impl, decoder_config);
+  const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(options.impl, fixed_config_of(capture_options));
 
   // Views in link order: (t, eye) as t * eyes + eye. A view that lost every packet never comes out of the receiver;
   // the panel holds its previous output for it, and it is decoded and handed on as lost.
-  const int eyes = config.link.stereo ? 2 : 1;
+  const int eyes = link.stereo ? 2 : 1;
   std::int64_t next_view = 0;
   cv::Size full_size;
   bool right_eye_arrived = false;
@@ -470,14 +460,14 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
       FrameMeta lost;
       lost.index = next_view / eyes;
       lost.eye = static_cast<int>(next_view % eyes);
-      lost.parity = parity_of(lost.index, lost.eye, config.link);
+      lost.parity = parity_of(lost.index, lost.eye, link);
       lost.full_width = full_size.width;
       lost.full_height = full_size.height;
       const bool full = lost.parity == Parity::Full;
-      lost.width = full ? full_size.width : reduced_size(full_size.width, config.link.reduction);
-      lost.height = full ? full_size.height : reduced_size(full_size.height, config.link.reduction);
-      lost.bits = config.link.bits;
-      lost.transfer = config.link.transfer;
+      lost.width = full ? full_size.width : reduced_size(full_size.width, link.reduction);
+      lost.height = full ? full_size.height : reduced_size(full_size.height, link.reduction);
+      lost.bits = link.bits;
+      lost.transfer = link.transfer;
       const DecodedFrame decoded = decoder->decode_lost(lost);
       ++result.views;
       ++result.lost_views;
@@ -490,11 +480,11 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
       throw std::runtime_error(where + "holds a view of eye " + std::to_string(m.eye) + " (stream " +
                                std::to_string(m.eye) + ") but its header says " + (eyes == 1 ? "mono" : "stereo"));
     }
-    if (m.parity != parity_of(m.index, m.eye, config.link)) {
+    if (m.parity != parity_of(m.index, m.eye, link)) {
       throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye) +
                                " is sent " + to_string(m.parity) + ", but the header's phase " +
-                               std::to_string(config.link.phase) + " makes it " +
-                               to_string(parity_of(m.index, m.eye, config.link)));
+                               std::to_string(link.phase) + " makes it " +
+                               to_string(parity_of(m.index, m.eye, link)));
     }
     const std::int64_t view_number = m.index * eyes + m.eye;
     if (view_number < next_view) {

@@ -121,5 +121,7 @@ class HeadsetDecoder {
 // invalid configuration.
 std::unique_ptr<HeadsetDecoder> make_decoder(const std::string& name, const FixedDecoderConfig& config);
 const std::vector<std::string>& decoder_names();
+// Throws make_decoder's std::invalid_argument unless `name` is one of decoder_names().
+void check_decoder_name(const std::string& name);
 
 }  // namespace trm
