@@ -1,10 +1,10 @@
 // The GPU-side TRM encoder (DESIGN §3-4, paper Sec. 4 and Fig. 4).
 #include "trm/encoder.hpp"
 
+#include "exact_text.hpp"
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -13,16 +13,7 @@ namespace trm {
 
 double EncoderConfig::effective_sigma() const { return sigma > 0.0 ? sigma : default_sigma(reduction); }
 
-namespace {
-
-// The shortest text that reads back as the same double: a message never shows 1.0000001 as 1.000000.
-std::string exact_text(double value) {
-  char text[32];
-  const auto [end, ec] = std::to_chars(text, text + sizeof text, value);
-  return ec == std::errc() ? std::string(text, end) : std::to_string(value);
-}
-
-}  // namespace
+using detail::exact_text;
 
 void EncoderConfig::validate() const {
   if (!(reduction > 0.0 && reduction <= 1.0)) {

@@ -1,6 +1,7 @@
 #include "trm/frame.hpp"
 
-#include <sstream>
+#include "exact_text.hpp"
+
 #include <stdexcept>
 #include <string>
 
@@ -32,9 +33,8 @@ const char* to_string(ResampleSpace s) { return s == ResampleSpace::Encoded ? "e
 
 void validate_refresh_hz(double hz, const std::string& what) {
   if (!(hz >= kMinRefreshHz && hz <= kMaxRefreshHz)) {
-    std::ostringstream message;
-    message << what << " must be a refresh rate from " << kMinRefreshHz << " to " << kMaxRefreshHz << " Hz, got " << hz;
-    throw std::invalid_argument(message.str());
+    throw std::invalid_argument(what + " must be a refresh rate from " + detail::exact_text(kMinRefreshHz) + " to " +
+                                detail::exact_text(kMaxRefreshHz) + " Hz, got " + detail::exact_text(hz));
   }
 }
 

@@ -49,6 +49,14 @@ double parse_number(const std::string& text, const std::string& what, const std:
   return v;
 }
 
+// A user-given rate in Gbit/s: above 0 and at most kMaxLinkGbps, so that every per-frame budget is finite.
+void require_rate(double gbps, const std::string& what, const std::string& preset) {
+  if (!(gbps > 0.0 && gbps <= kMaxLinkGbps)) {
+    throw std::invalid_argument("link preset '" + preset + "': " + what + " must be > 0 and <= " +
+                                std::to_string(static_cast<int>(kMaxLinkGbps)) + " Gbit/s");
+  }
+}
+
 }  // namespace
 
 const std::vector<LinkPreset>& builtin_link_presets() {
@@ -67,9 +75,7 @@ LinkPreset parse_link_preset(const std::string& text) {
 
   if (text.rfind("wigig:", 0) == 0) {
     const double gbps = parse_number(text.substr(6), "practical throughput", text);
-    if (!(gbps > 0.0 && gbps <= kMaxLinkGbps))
-      throw std::invalid_argument("link preset '" + text + "': practical throughput must be > 0 and <= " +
-                                  std::to_string(static_cast<int>(kMaxLinkGbps)) + " Gbit/s");
+    require_rate(gbps, "practical throughput", text);
     return {text, "802.11ad, practical throughput " + text.substr(6) + " Gbit/s", gbps, 1.0};
   }
   if (text.rfind("custom:", 0) == 0) {
@@ -79,9 +85,7 @@ LinkPreset parse_link_preset(const std::string& text) {
       throw std::invalid_argument("link preset '" + text + "': expected custom:RATE_GBPS:EFFICIENCY, e.g. custom:10:0.8");
     const double rate = parse_number(rest.substr(0, colon), "rate", text);
     const double efficiency = parse_number(rest.substr(colon + 1), "efficiency", text);
-    if (!(rate > 0.0 && rate <= kMaxLinkGbps))
-      throw std::invalid_argument("link preset '" + text + "': rate must be > 0 and <= " +
-                                  std::to_string(static_cast<int>(kMaxLinkGbps)) + " Gbit/s");
+    require_rate(rate, "rate", text);
     if (!(efficiency > 0.0 && efficiency <= 1.0))
       throw std::invalid_argument("link preset '" + text + "': coding efficiency must be in (0, 1]");
     return {text, "custom link", rate, efficiency};
