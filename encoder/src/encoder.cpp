@@ -74,6 +74,12 @@ cv::Mat reduce_codes(const cv::Mat& full_codes, const EncoderConfig& config) {
 TrmEncoder::TrmEncoder(EncoderConfig config) : config_(config) { config_.validate(); }
 
 LinkFrame TrmEncoder::encode(const cv::Mat& linear_full, std::int64_t t, int eye) const {
+  return encode_as(parity_of(t, eye, config_), linear_full, t, eye);
+}
+
+LinkFrame TrmEncoder::encode_as(Parity parity, const cv::Mat& linear_full, std::int64_t t, int eye) const {
+  if (t < 0) throw std::invalid_argument("encode: frame index must be >= 0, got " + std::to_string(t));
+  if (eye != 0 && eye != 1) throw std::invalid_argument("encode: eye must be 0 or 1, got " + std::to_string(eye));
   if (linear_full.type() != CV_64FC3 || linear_full.empty()) {
     throw std::invalid_argument("encode: expected a non-empty CV_64FC3 linear RGB frame");
   }
@@ -88,7 +94,7 @@ LinkFrame TrmEncoder::encode(const cv::Mat& linear_full, std::int64_t t, int eye
   LinkFrame frame;
   frame.meta.index = t;
   frame.meta.eye = eye;
-  frame.meta.parity = parity_of(t, eye, config_);
+  frame.meta.parity = parity;
   frame.meta.full_width = linear_full.cols;
   frame.meta.full_height = linear_full.rows;
   frame.meta.bits = config_.bits;

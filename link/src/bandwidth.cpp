@@ -86,10 +86,13 @@ std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double
   return std::nullopt;
 }
 
-FramesCsvWriter::FramesCsvWriter(const std::filesystem::path& path, double refresh_hz)
-    : file_(path), refresh_hz_(refresh_hz) {
+FramesCsvWriter::FramesCsvWriter(const std::filesystem::path& path, double refresh_hz, std::string method)
+    : file_(path), refresh_hz_(refresh_hz), method_(std::move(method)) {
+  if (method_.find_first_of(",\"\n") != std::string::npos) {
+    throw std::invalid_argument("frames.csv: method name '" + method_ + "' cannot be a CSV field");
+  }
   file_.write("link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,"
-              "wire_time_s,available_time_s,utilisation,fits\n");
+              "wire_time_s,available_time_s,utilisation,fits,method\n");
 }
 
 void FramesCsvWriter::add(const LinkFrameUsage& u) {
@@ -97,7 +100,7 @@ void FramesCsvWriter::add(const LinkFrameUsage& u) {
   row << std::setprecision(9) << u.index << ',' << static_cast<double>(u.index) / refresh_hz_ << ',' << u.views << ','
       << u.parities << ',' << u.bits.pixel_bits << ',' << u.bits.payload_bits << ',' << u.bits.overhead_bits << ','
       << u.bits.wire_bits() << ',' << u.bits.packets << ',' << u.wire_seconds << ',' << u.available_seconds << ','
-      << u.utilisation << ',' << (u.fits ? 1 : 0) << '\n';
+      << u.utilisation << ',' << (u.fits ? 1 : 0) << ',' << method_ << '\n';
   file_.write(row.str());
 }
 
@@ -107,8 +110,9 @@ void FramesCsvWriter::close() {
   closed_ = true;
 }
 
-void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz) {
-  FramesCsvWriter writer(path, refresh_hz);
+void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz,
+                      const std::string& method) {
+  FramesCsvWriter writer(path, refresh_hz, method);
   for (const LinkFrameUsage& u : frames) writer.add(u);
   writer.close();
 }

@@ -160,14 +160,15 @@ TEST(Bandwidth, CsvAndPlotAreWritten) {
   BandwidthMeter meter({parse_link_preset("custom:1:1"), 100.0, std::nullopt});
   const std::vector<LinkFrameUsage> frames = {meter.add(0, "F", ViewBits{100, 100, 20, 1}, 1),
                                               meter.add(1, "R", ViewBits{50, 50, 20, 1}, 1)};
-  write_frames_csv(dir / "frames.csv", frames, 100.0);
+  write_frames_csv(dir / "frames.csv", frames, 100.0, "trm");
   std::ifstream in(dir / "frames.csv");
   std::stringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str().substr(0, text.str().find('\n')),
             "link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,"
-            "wire_time_s,available_time_s,utilisation,fits");
+            "wire_time_s,available_time_s,utilisation,fits,method");
   EXPECT_NE(text.str().find("\n1,0.01,1,R,50,50,20,70,1,"), std::string::npos);
+  EXPECT_NE(text.str().find(",1,trm\n"), std::string::npos) << "each row ends with its method";
 
   std::vector<PlotSeries> series = {{"full rate", {100, 100, 100}}, {"TRM mono", {100, 50, 100}},
                                     {"TRM stereo", {75, 75, 75}}};
@@ -177,7 +178,7 @@ TEST(Bandwidth, CsvAndPlotAreWritten) {
   EXPECT_EQ(png.rows, 640);
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     EXPECT_EQ(entry.path().string().find(".partial-"), std::string::npos) << "staging file left: " << entry.path();
-  EXPECT_THROW(write_frames_csv(dir / "no_such_dir" / "frames.csv", frames, 100.0), std::runtime_error);
+  EXPECT_THROW(write_frames_csv(dir / "no_such_dir" / "frames.csv", frames, 100.0, "trm"), std::runtime_error);
 }
 
 TEST(Bandwidth, PlotTraceStaysBoundedAndKeepsTheEnvelope) {

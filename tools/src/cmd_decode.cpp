@@ -60,14 +60,16 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
   OutputDir dir(out);
   JsonLinesWriter views(dir.file("views.jsonl"));
   const CaptureDecodeResult result =
-      decode_capture_stream(options, capture_path, [&](const FrameMeta& meta, const link::ReceivedFrame* received,
-                                                       const DecodedFrame& decoded) {
-        // A lost view is written too: it is what the panel shows (its previous output, held).
+      decode_capture_stream(options, capture_path, [&](const FrameMeta& meta, SlotOutcome outcome,
+                                                       const link::ReceivedFrame* received, const DecodedFrame& decoded) {
+        // A lost view is written too: it is what the panel shows (its previous output, held); so is a slot the
+        // method sends nothing for.
         write_drive_files(dir, meta, decoded, options.output_bits);
         views.write({{"t", meta.index},
                      {"eye", meta.eye},
                      {"parity", to_string(meta.parity)},
-                     {"lost", received == nullptr},
+                     {"sent", outcome != SlotOutcome::NotSent},
+                     {"lost", outcome == SlotOutcome::Lost},
                      {"intact_lines", received ? received->intact_lines() : 0},
                      {"concealed_lines", decoded.stats.concealed_lines},
                      {"clipped_fraction", decoded.stats.clipped_fraction}});
@@ -81,7 +83,8 @@ int decode_capture(const PipelineOptions& options, const std::string& capture_pa
   report["parameters"] = {{"sensitivity", options.sensitivity},
                           {"panel", options.panel},
                           {"output_bits", options.output_bits},
-                          {"impl", options.impl}};
+                          {"method", result.method},
+                          {"impl", result.impl}};
   report["receiver"] = receiver_json(c);
   report["summary"] = {
       {"views", result.views}, {"lost_views", result.lost_views}, {"concealed_lines", result.concealed_lines}};
@@ -104,6 +107,7 @@ void register_decode(CLI::App& app, Action& action) {
                 "or drive10_*.png) and report.json");
   auto capture = std::make_shared<std::string>();
   options->add_options(*cmd);
+  options->add_method_option(*cmd);
   cmd->add_option("--capture", *capture,
                   "Decode a recorded packet stream (.trmcap) instead of --input, with the --impl decoder (lost lines "
                   "concealed)")
@@ -125,7 +129,7 @@ void register_decode(CLI::App& app, Action& action) {
       RunRecorder recorder(*options, dir.staging());
       const std::int64_t frames = run_pipeline(*options, [&](const DecodedView& view) {
         recorder.add(view);
-        write_drive_files(dir, view.sent->meta, *view.decoded, options->output_bits);
+        write_drive_files(dir, view.slot, *view.decoded, options->output_bits);
       }).frames;
       recorder.close();
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

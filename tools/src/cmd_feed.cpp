@@ -235,7 +235,7 @@ int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
     };
     if (!s.capture.empty()) {
       decode_capture_stream(pipeline, s.capture,
-                            [&](const FrameMeta&, const link::ReceivedFrame*, const DecodedFrame& decoded) {
+                            [&](const FrameMeta&, SlotOutcome, const link::ReceivedFrame*, const DecodedFrame& decoded) {
                               feed_decoded(decoded);
                             });
     } else {
@@ -259,6 +259,7 @@ void register_feed(CLI::App& app, Action& action) {
   auto settings = std::make_shared<FeedSettings>();
   auto pipeline = std::make_shared<PipelineOptions>();
   pipeline->add_options(*cmd);
+  pipeline->add_method_option(*cmd);
   FeedSettings& s = *settings;
 
   cmd->add_option("--capture", s.capture, "Feed the frames decoded from a recorded packet stream (.trmcap)")

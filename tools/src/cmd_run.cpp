@@ -46,6 +46,7 @@ void register_run(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand("run", "Run the whole chain on a scene or input and write a report (default: "
                                             "discs, 1080x1200, 90 Hz, r = 1/2, vive OLED)");
   options->add_options(*cmd);
+  options->add_method_option(*cmd);
   options->add_link_options(*cmd);
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   action = nullptr;
@@ -73,14 +74,15 @@ void register_run(CLI::App& app, Action& action) {
       if (link_recorder) link_sink = [&](const link::LinkFrameUsage& usage) { link_recorder->add(usage); };
       const PipelineResult result = run_pipeline(run_options, [&](const DecodedView& view) {
         const cv::Mat perceived = recorder.add(view);
-        const FrameMeta& meta = view.sent->meta;
+        const FrameMeta& meta = view.slot;
         if (!previews_written && meta.eye == 0) {
+          // The first pair of slots (TRM's full slot, then its reduced one), whatever the method sends in them.
           if (meta.parity == Parity::Full) {
             first_full_shown = view.decoded->wanted_linear.clone();
-            first_full_sent = LinkFrame{meta, view.sent->codes.clone()};
+            first_full_sent = view.sent ? LinkFrame{meta, view.sent->codes.clone()} : LinkFrame{};
           } else if (!first_full_shown.empty() && !perceived.empty()) {
-            dir.write_png("pair_sent_full.png", codes_preview(first_full_sent));
-            dir.write_png("pair_sent_reduced.png", codes_preview(*view.sent));
+            if (!first_full_sent.codes.empty()) dir.write_png("pair_sent_full.png", codes_preview(first_full_sent));
+            if (view.sent) dir.write_png("pair_sent_reduced.png", codes_preview(*view.sent));
             dir.write_png("pair_shown_beta.png", preview_8bit(first_full_shown));
             dir.write_png("pair_shown_alpha.png", preview_8bit(view.decoded->wanted_linear));
             dir.write_png("pair_perceived.png", preview_8bit(perceived));

@@ -43,8 +43,8 @@ link::PlotTrace predicted_trace(std::string label, const PipelineOptions& option
 LinkRecorder::LinkRecorder(const OutputDir& dir, const PipelineOptions& options)
     : dir_(dir),
       options_(options),
-      csv_(dir.file("frames.csv"), options.refresh_hz),
-      measured_(std::string("TRM ") + (options.encoder.stereo ? "stereo off-phase" : "mono") + " (this run)") {}
+      csv_(dir.file("frames.csv"), options.refresh_hz, options.method),
+      measured_(options.method + (options.encoder.stereo ? " stereo" : " mono") + " (this run)") {}
 
 void LinkRecorder::add(const link::LinkFrameUsage& usage) {
   csv_.add(usage);
@@ -69,6 +69,7 @@ Json LinkRecorder::finish(const LinkOutcome& outcome, int full_width, int full_h
 
   const link::BandwidthSummary& s = outcome.summary;
   Json j;
+  j["method"] = options_.method;
   j["preset"] = outcome.budget.preset.name;
   j["description"] = outcome.budget.preset.description;
   j["data_gbps"] = outcome.budget.preset.data_gbps();
@@ -78,6 +79,8 @@ Json LinkRecorder::finish(const LinkOutcome& outcome, int full_width, int full_h
   j["frames_not_fitting"] = s.frames_not_fitting;
   j["peak_wire_bits"] = s.peak_wire_bits;
   j["average_wire_bits"] = s.average_wire_bits;
+  j["peak_payload_bits"] = s.peak_payload_bits;
+  j["average_payload_bits"] = s.average_payload_bits;  // per link frame
   j["peak_utilisation"] = s.peak_utilisation;
   j["average_utilisation"] = s.average_utilisation;
   j["total_pixel_bits"] = s.total_pixel_bits;

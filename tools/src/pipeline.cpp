@@ -33,6 +33,7 @@ bool looks_like_image_sequence(const std::string& input) {
 // Stored in a capture's header so that `trm decode --capture` can rebuild the decoder's link configuration.
 std::string capture_metadata(const PipelineOptions& options, std::int64_t frames) {
   nlohmann::ordered_json meta;
+  meta["method"] = options.method;
   meta["reduction"] = options.encoder.reduction;
   meta["sigma"] = options.encoder.effective_sigma();
   meta["phase"] = options.encoder.phase;
@@ -201,10 +202,34 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_flag("--no-skip", no_skip,
                "Fixed-point decoders: do not skip the work a scene does not need (static lines' motion test, "
                "all-zero residual lines); the output is bit-identical either way");
-  cmd.add_option("--impl", impl,
-                 "Decoder: reference (double), fixed (fixed-point, line-buffered streaming: the hardware model) or "
-                 "fixed-frame (the same arithmetic frame at a time); each conceals lines and views lost on the link")
+  cmd.add_option_function<std::string>(
+         "--impl",
+         [this](const std::string& name) {
+           impl = name;
+           impl_given = true;
+         },
+         "Decoder of the methods that send TRM frames (trm, ncsfi): reference (double), fixed (fixed-point, "
+         "line-buffered streaming: the hardware model) or fixed-frame (the same arithmetic frame at a time); each "
+         "conceals lines and views lost on the link")
+      ->default_str(impl);
+}
+
+void PipelineOptions::add_method_option(CLI::App& cmd) {
+  cmd.add_option("--method", method,
+                 "Display method: trm, full, half-rate, interlace[:double], bfi or ncsfi (`trm methods` lists them)")
       ->capture_default_str();
+}
+
+std::string PipelineOptions::method_impl() const {
+  return find_display_method(method).method->fixed_point ? impl : "reference";
+}
+
+MethodSetup PipelineOptions::method_setup() const {
+  MethodSetup setup;
+  setup.decoder = fixed_config_of(*this);
+  setup.impl = method_impl();
+  setup.option = find_display_method(method).option;
+  return setup;
 }
 
 void PipelineOptions::add_link_options(CLI::App& cmd) {
@@ -262,9 +287,14 @@ void PipelineOptions::validate() const {
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string("--impl: ") + e.what());
   }
+  try {
+    check_display_method(method, impl_given ? impl : method_impl());
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--method: ") + e.what());
+  }
   // The decoder's whole configuration, before any output exists: the fixed-point formats only for those decoders.
   const FixedDecoderConfig decoder_config = fixed_config_of(*this);
-  if (impl == "reference") decoder_config.decoder.validate(); else decoder_config.validate();
+  if (method_impl() == "reference") decoder_config.decoder.validate(); else decoder_config.validate();
   // Link and fault options are checked whether or not they switch the link on (--ber -1 is an error either way).
   (void)link_config(width, height);
   if (input.empty()) {
@@ -298,18 +328,25 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     frames = options.default_frames;
   }
 
-  TrmEncoder encoder(options.encoder);
-  const FixedDecoderConfig fixed_config = fixed_config_of(options);
-  const DecoderConfig& decoder_config = fixed_config.decoder;
-  const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(options.impl, fixed_config);
+  const MethodSetup setup = options.method_setup();
+  const MethodChoice method = find_display_method(options.method);
+  const std::unique_ptr<MethodSender> sender = method.method->make_sender(setup);
+  const std::unique_ptr<MethodDisplay> display = method.method->make_display(setup);
+  HeadsetDecoder* const decoder = display->decoder();  // the TRM decoder inside, if the method has one
   // The reference beside a fixed-point decoder sees exactly the same input.
-  const bool compare = options.compare_reference && options.impl != "reference";
-  std::optional<ReferenceDecoder> reference_beside;
-  if (compare) reference_beside.emplace(decoder_config);
+  const bool compare = options.compare_reference && decoder != nullptr && setup.impl != "reference";
+  MethodSetup reference_setup = setup;
+  reference_setup.impl = "reference";
+  std::unique_ptr<MethodDisplay> reference_beside;
+  if (compare) reference_beside = method.method->make_display(reference_setup);
   // LCD codes compared free-running drift apart by the design's neutral mode (see adopt_panel_history); the
   // synchronised comparison is the criterion, the free-running one is reported beside it.
-  std::optional<ReferenceDecoder> free_running;
-  if (compare && decoder_config.panel.kind == PanelKind::Lcd) free_running.emplace(decoder_config);
+  std::unique_ptr<MethodDisplay> free_running;
+  if (compare && setup.decoder.decoder.panel.kind == PanelKind::Lcd) {
+    free_running = method.method->make_display(reference_setup);
+  }
+  auto* const synchronised_reference =
+      reference_beside ? dynamic_cast<ReferenceDecoder*>(reference_beside->decoder()) : nullptr;
 
   std::optional<link::LinkSimulation> simulation;
   PipelineResult result;
@@ -323,17 +360,25 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     result.link.emplace();
   }
 
+  const cv::Size full(source->width(), source->height());
   const int eyes = options.encoder.stereo ? 2 : 1;
-  std::vector<LinkFrame> sent(static_cast<std::size_t>(eyes));
-  std::vector<double> encode_seconds(static_cast<std::size_t>(eyes));
   for (std::int64_t t = 0; t < frames; ++t) {
     const auto render_start = std::chrono::steady_clock::now();
     const cv::Mat linear = source->linear_frame(t);
     const double render_seconds = seconds_since(render_start);
+    // The GPU side: the views this method sends at t, in stream order.
+    std::vector<LinkFrame> sent;
+    std::vector<int> sent_index(static_cast<std::size_t>(eyes), -1);
+    std::vector<std::int64_t> pixels_rendered(static_cast<std::size_t>(eyes), 0);
+    std::vector<double> encode_seconds(static_cast<std::size_t>(eyes), 0.0);
     for (int eye = 0; eye < eyes; ++eye) {
+      if (!sender->sends(t, eye)) continue;
       const auto start = std::chrono::steady_clock::now();
-      sent[static_cast<std::size_t>(eye)] = encoder.encode(linear, t, eye);
+      Transmission transmission = sender->send(linear, t, eye);
       encode_seconds[static_cast<std::size_t>(eye)] = seconds_since(start);
+      pixels_rendered[static_cast<std::size_t>(eye)] = transmission.pixels_rendered;
+      sent_index[static_cast<std::size_t>(eye)] = static_cast<int>(sent.size());
+      sent.push_back(std::move(transmission.frame));
     }
     std::vector<link::ReceivedFrame> received;
     if (simulation) {
@@ -341,55 +386,48 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
       if (link_sink) link_sink(simulation->meter().last());
     }
     for (int eye = 0; eye < eyes; ++eye) {
-      const LinkFrame& view_sent = sent[static_cast<std::size_t>(eye)];
-      const auto start = std::chrono::steady_clock::now();
-      DecodedFrame decoded;
-      DecodedFrame reference;
-      DecodedFrame free_running_reference;
-      double decode_seconds = 0.0;  // of the decoder under test, not of the reference beside it
-      if (simulation) {
-        const link::ReceivedFrame* arrived = nullptr;
+      const int index = sent_index[static_cast<std::size_t>(eye)];
+      const LinkFrame* view_sent = index >= 0 ? &sent[static_cast<std::size_t>(index)] : nullptr;
+      const FrameMeta slot = view_sent ? view_sent->meta : unsent_slot(t, eye, full, options.encoder);
+      // One slot through a display: what arrived, what was lost, or what was never sent.
+      const link::ReceivedFrame* arrived = nullptr;
+      bool lost = false;
+      if (view_sent && simulation) {
         for (const auto& r : received) {
           if (r.meta.eye == eye && r.meta.index == t) arrived = &r;
         }
-        if (arrived) {
-          const LinkFrame frame{arrived->meta, arrived->codes};
-          decoded = decoder->decode(frame, arrived->line_intact);
-          decode_seconds = seconds_since(start);
-          if (compare) {
-            reference = reference_beside->decode(frame, arrived->line_intact);
-            if (free_running) {
-              reference_beside->adopt_panel_history(decoded);
-              free_running_reference = free_running->decode(frame, arrived->line_intact);
-            }
-          }
-        } else {
-          decoded = decoder->decode_lost(view_sent.meta);
-          decode_seconds = seconds_since(start);
-          if (compare) reference = reference_beside->decode_lost(view_sent.meta);
-          if (free_running) free_running_reference = free_running->decode_lost(view_sent.meta);
-          ++result.link->lost_views;
-        }
-        result.link->concealed_lines += decoded.stats.concealed_lines;
-      } else {
-        decoded = decoder->decode(view_sent);
-        decode_seconds = seconds_since(start);
-        if (compare) {
-          reference = reference_beside->decode(view_sent);
-          if (free_running) {
-            reference_beside->adopt_panel_history(decoded);
-            free_running_reference = free_running->decode(view_sent);
-          }
-        }
+        lost = arrived == nullptr;
       }
+      const auto show = [&](MethodDisplay& on) {
+        if (!view_sent) return on.show_unsent(slot);
+        if (lost) return on.show_lost(slot);
+        if (arrived) return on.show(LinkFrame{arrived->meta, arrived->codes}, arrived->line_intact);
+        return on.show(*view_sent, {});
+      };
+      const auto start = std::chrono::steady_clock::now();
+      const DecodedFrame decoded = show(*display);
+      const double decode_seconds = seconds_since(start);  // of the display under test, not of the reference beside
+      DecodedFrame reference;
+      DecodedFrame free_running_reference;
+      if (compare) {
+        reference = show(*reference_beside);
+        if (free_running && synchronised_reference && !lost) {
+          synchronised_reference->adopt_panel_history(decoded);
+        }
+        if (free_running) free_running_reference = show(*free_running);
+      }
+      if (lost) ++result.link->lost_views;
+      if (simulation) result.link->concealed_lines += decoded.stats.concealed_lines;
       DecodedView view;
       view.source = source.get();
       view.linear_full = &linear;
-      view.sent = &view_sent;
+      view.slot = slot;
+      view.sent = view_sent;
+      view.pixels_rendered = pixels_rendered[static_cast<std::size_t>(eye)];
       view.decoded = &decoded;
       if (compare) view.reference = &reference;
       if (free_running) view.free_running_reference = &free_running_reference;
-      view.fixed_counts = decoder->stage_counts();
+      view.fixed_counts = decoder ? decoder->stage_counts() : nullptr;
       view.render_seconds = render_seconds;
       view.encode_seconds = encode_seconds[static_cast<std::size_t>(eye)];
       view.decode_seconds = decode_seconds;
@@ -397,7 +435,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     }
   }
   result.frames = frames;
-  if (FixedStreamingReport hardware; decoder->hardware_report(cv::Size(source->width(), source->height()), hardware)) {
+  if (FixedStreamingReport hardware; decoder && decoder->hardware_report(full, hardware)) {
     result.hardware = std::move(hardware);
   }
   if (simulation) {
@@ -445,71 +483,84 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + "invalid configuration in its header: " + e.what());
   }
-  const std::unique_ptr<HeadsetDecoder> decoder = make_decoder(options.impl, fixed_config_of(capture_options));
+  // Captures written before display methods existed carry TRM frames.
+  capture_options.method = meta.value("method", std::string("trm"));
+  try {
+    check_display_method(capture_options.method, capture_options.impl_given ? capture_options.impl
+                                                                            : capture_options.method_impl());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + "its method: " + e.what());
+  }
+  const MethodSetup setup = capture_options.method_setup();
+  const MethodChoice method = find_display_method(capture_options.method);
+  // The sender is built only for its schedule: which views were sent at all, and what each looked like.
+  const std::unique_ptr<MethodSender> schedule = method.method->make_sender(setup);
+  const std::unique_ptr<MethodDisplay> display = method.method->make_display(setup);
 
   // Views in link order: (t, eye) as t * eyes + eye. A view that lost every packet never comes out of the receiver;
-  // the panel holds its previous output for it, and it is decoded and handed on as lost.
+  // the panel holds its previous output for it, and it is decoded and handed on as lost. A slot the method sends
+  // nothing for is shown as the method shows it and handed on as not sent.
   const int eyes = link.stereo ? 2 : 1;
   std::int64_t next_view = 0;
   cv::Size full_size;
   bool right_eye_arrived = false;
   CaptureDecodeResult result;
   result.link_configuration = meta.dump();
-  const auto hand_on_lost_views_before = [&](std::int64_t view_number) {
+  result.method = capture_options.method;
+  result.impl = setup.impl;
+  const auto hand_on_views_before = [&](std::int64_t view_number) {
     for (; next_view < view_number; ++next_view) {
-      FrameMeta lost;
-      lost.index = next_view / eyes;
-      lost.eye = static_cast<int>(next_view % eyes);
-      lost.parity = parity_of(lost.index, lost.eye, link);
-      lost.full_width = full_size.width;
-      lost.full_height = full_size.height;
-      const bool full = lost.parity == Parity::Full;
-      lost.width = full ? full_size.width : reduced_size(full_size.width, link.reduction);
-      lost.height = full ? full_size.height : reduced_size(full_size.height, link.reduction);
-      lost.bits = link.bits;
-      lost.transfer = link.transfer;
-      const DecodedFrame decoded = decoder->decode_lost(lost);
+      const std::int64_t t = next_view / eyes;
+      const int eye = static_cast<int>(next_view % eyes);
       ++result.views;
+      if (!schedule->sends(t, eye)) {
+        const FrameMeta slot = unsent_slot(t, eye, full_size, link);
+        sink(slot, SlotOutcome::NotSent, nullptr, display->show_unsent(slot));
+        continue;
+      }
+      const FrameMeta lost = schedule->view_meta(t, eye, full_size);
       ++result.lost_views;
-      sink(lost, nullptr, decoded);
+      sink(lost, SlotOutcome::Lost, nullptr, display->show_lost(lost));
     }
   };
   while (auto received = replay.next_frame()) {
     const FrameMeta& m = received->meta;
+    const std::string view = "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye);
     if (m.eye >= eyes) {
       throw std::runtime_error(where + "holds a view of eye " + std::to_string(m.eye) + " (stream " +
                                std::to_string(m.eye) + ") but its header says " + (eyes == 1 ? "mono" : "stereo"));
     }
-    if (m.parity != parity_of(m.index, m.eye, link)) {
-      throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye) +
-                               " is sent " + to_string(m.parity) + ", but the header's phase " +
-                               std::to_string(link.phase) + " makes it " +
-                               to_string(parity_of(m.index, m.eye, link)));
+    if (!schedule->sends(m.index, m.eye)) {
+      throw std::runtime_error(where + view + " arrived, but method '" + capture_options.method +
+                               "' sends nothing there");
+    }
+    const FrameMeta expected = schedule->view_meta(m.index, m.eye, cv::Size(m.full_width, m.full_height));
+    if (m.parity != expected.parity || m.width != expected.width || m.height != expected.height) {
+      throw std::runtime_error(where + view + " is sent " + to_string(m.parity) + " " + std::to_string(m.width) + "x" +
+                               std::to_string(m.height) + ", but the header's method '" + capture_options.method +
+                               "' and phase " + std::to_string(link.phase) + " make it " + to_string(expected.parity) +
+                               " " + std::to_string(expected.width) + "x" + std::to_string(expected.height));
     }
     const std::int64_t view_number = m.index * eyes + m.eye;
-    if (view_number < next_view) {
-      throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye) +
-                               " arrives after a later one");
-    }
+    if (view_number < next_view) throw std::runtime_error(where + view + " arrives after a later one");
     if (frames_sent && m.index >= *frames_sent) {
-      throw std::runtime_error(where + "view t=" + std::to_string(m.index) + " lies beyond the " +
-                               std::to_string(*frames_sent) + " frames its header says were sent");
+      throw std::runtime_error(where + view + " lies beyond the " + std::to_string(*frames_sent) +
+                               " frames its header says were sent");
     }
     if (full_size.empty()) full_size = cv::Size(m.full_width, m.full_height);
     if (m.eye == 1) right_eye_arrived = true;
-    hand_on_lost_views_before(view_number);
-    const LinkFrame frame{m, received->codes};
-    const DecodedFrame decoded = decoder->decode(frame, received->line_intact);
+    hand_on_views_before(view_number);
+    const DecodedFrame decoded = display->show(LinkFrame{m, received->codes}, received->line_intact);
     result.concealed_lines += decoded.stats.concealed_lines;
     ++result.views;
     ++next_view;
-    sink(m, &*received, decoded);
+    sink(m, SlotOutcome::Arrived, &*received, decoded);
   }
   if (full_size.empty()) throw std::runtime_error(where + "holds no frame that arrived");
   if (eyes == 2 && !right_eye_arrived) {
     throw std::runtime_error(where + "its header says stereo, but no view of eye 1 (stream 1) arrived: a mono stream");
   }
-  if (frames_sent) hand_on_lost_views_before(*frames_sent * eyes);
+  if (frames_sent) hand_on_views_before(*frames_sent * eyes);
   result.receiver = replay.counters();
   return result;
 }

@@ -2,6 +2,7 @@
 // encoder, and a decoder, producing panel drive frames in order.
 #pragma once
 
+#include "trm/display_method.hpp"
 #include "trm/encoder.hpp"
 #include "trm/fixed_decoder.hpp"
 #include "trm/link_simulation.hpp"
@@ -31,7 +32,9 @@ struct PipelineOptions {
   double sensitivity = 10.0;
   std::string panel = "vive";
   int output_bits = 8;
+  std::string method = "trm";         // display method (trm/display_method.hpp): NAME or NAME:OPTION
   std::string impl = "reference";     // reference | fixed (streaming, the hardware model) | fixed-frame
+  bool impl_given = false;            // --impl was on the command line (a plain-frame method then refuses fixed)
   bool compare_reference = false;     // with a fixed impl: also run the reference and compare codes
   int residual_bits = 0;              // fixed impl: residual store width N (sQ2.(N-2)); 0 = the default
   bool no_skip = false;               // fixed impl: run the full path everywhere (FixedDecoderConfig::skip_unneeded)
@@ -55,22 +58,32 @@ struct PipelineOptions {
   // faults or a capture were asked for.
   link::LinkSimulationConfig link_config(int full_width, int full_height) const;
 
+  // Adds --method: the commands that show a sequence on the panel (run, decode, feed); the others model TRM's decoder.
+  void add_method_option(CLI::App& cmd);
+
   // Adds the shared options (--scene --input --image --frames --size --refresh --reduction --sigma
   // --phase --transfer --resample-space --bits --stereo --sensitivity --panel --output-bits --seed)
   // to a subcommand.
   void add_options(CLI::App& cmd);
   // Validates everything up front (throws std::invalid_argument with one clear message).
   void validate() const;
+  // The decoder the method's headset side uses: --impl for a method that decodes TRM frames, else the reference
+  // (a plain-frame method has no fixed-point decoder; an explicit --impl other than reference is refused).
+  std::string method_impl() const;
+  // What the method is built from.
+  MethodSetup method_setup() const;
   // The frame source these options name: the --input sequence or video, else the built-in scene.
   std::unique_ptr<FrameSource> open_source() const;
 };
 
-// One decoded view, as the pipeline hands it to a sink.
+// One decoded view slot, as the pipeline hands it to a sink.
 struct DecodedView {
   const FrameSource* source = nullptr;
-  const cv::Mat* linear_full = nullptr;   // what was rendered (full resolution, linear)
-  const LinkFrame* sent = nullptr;        // what crossed the link
-  const DecodedFrame* decoded = nullptr;  // what the decoder produced
+  const cv::Mat* linear_full = nullptr;   // the scene at t (full resolution, linear): what full rate would render
+  FrameMeta slot;                         // the view as sent, or (nothing sent) unsent_slot()
+  const LinkFrame* sent = nullptr;        // what crossed the link; null when the method sends nothing in this slot
+  std::int64_t pixels_rendered = 0;       // what the method's GPU side rendered for this view
+  const DecodedFrame* decoded = nullptr;  // what the headset showed
   // The reference decoder's output, when compared beside a fixed impl. LCD: the reference takes the fixed
   // decoder's drive codes as its panel history after every frame (ReferenceDecoder::adopt_panel_history), so each
   // frame's inverse is compared from the same panel state; free_running_reference keeps its own history.
@@ -113,14 +126,19 @@ struct PipelineResult {
 // the capture's header; panel, sensitivity, output bits and the fixed-point residual width from the options. Throws link::CaptureError / std::runtime_error with the file name on a bad capture.
 struct CaptureDecodeResult {
   std::string link_configuration;   // the capture header's JSON
+  std::string method;               // the display method the capture was sent with (its header's, else trm)
+  std::string impl;                 // the decoder its headset side used
   link::ReceiverCounters receiver;
-  std::int64_t views = 0;           // handed to the sink, lost ones included
+  std::int64_t views = 0;           // slots handed to the sink, lost and unsent ones included
   std::int64_t lost_views = 0;      // views none of whose packets arrived (the panel held its previous output)
   std::int64_t concealed_lines = 0;
 };
-// Called for every view in link order: `received` is null for a lost view (decoded is then the held output).
-using CaptureSink =
-    std::function<void(const FrameMeta& meta, const link::ReceivedFrame* received, const DecodedFrame& decoded)>;
+// What became of a view slot of a replayed capture.
+enum class SlotOutcome { Arrived, Lost, NotSent };
+// Called for every view slot in link order: `received` is null unless it arrived (a lost view shows the held output;
+// a slot the method sends nothing for shows what the method shows there).
+using CaptureSink = std::function<void(const FrameMeta& meta, SlotOutcome outcome, const link::ReceivedFrame* received,
+                                       const DecodedFrame& decoded)>;
 CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const std::string& capture_path,
                                           const CaptureSink& sink);
 

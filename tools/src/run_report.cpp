@@ -107,18 +107,24 @@ void RunRecorder::close() {
 
 cv::Mat RunRecorder::add(const DecodedView& view) {
   const DecodedFrame& d = *view.decoded;
-  const FrameMeta& meta = view.sent->meta;
+  const FrameMeta& meta = view.slot;
   full_width_ = meta.full_width;
   full_height_ = meta.full_height;
   FrameMeta full_meta = meta;
   full_meta.width = meta.full_width;
   full_meta.height = meta.full_height;
-  const std::int64_t bytes = payload_bytes(meta);
+  const std::int64_t bytes = view.sent ? payload_bytes(meta) : 0;
+  const std::int64_t full_pixels = static_cast<std::int64_t>(meta.full_width) * meta.full_height;
   sum_payload_ += static_cast<double>(bytes);
   sum_full_payload_ += static_cast<double>(payload_bytes(full_meta));
+  sum_pixels_rendered_ += static_cast<double>(view.pixels_rendered);
+  sum_pixels_sent_ += view.sent ? static_cast<double>(view.sent->codes.total()) : 0.0;
+  sum_pixels_full_ += static_cast<double>(full_pixels);
   if (meta.parity == Parity::Reduced) {
-    reduced_width_ = meta.width;
-    reduced_height_ = meta.height;
+    if (view.sent) {
+      reduced_width_ = meta.width;
+      reduced_height_ = meta.height;
+    }
   } else {
     ++full_views_;
     sum_clipped_full_ += d.stats.clipped_fraction;
@@ -131,7 +137,9 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   rec["t"] = meta.index;
   rec["eye"] = meta.eye;
   rec["parity"] = to_string(meta.parity);
-  rec["sent_size"] = {meta.width, meta.height};
+  rec["sent"] = view.sent != nullptr;
+  rec["sent_size"] = view.sent ? Json::array({meta.width, meta.height}) : Json::array({0, 0});
+  rec["pixels_rendered"] = view.pixels_rendered;
   rec["payload_bytes"] = bytes;
   rec["clipped_fraction"] = d.stats.clipped_fraction;
   rec["residual_mean_abs"] = d.stats.residual_mean_abs;
@@ -221,15 +229,22 @@ Json RunRecorder::report(double wall_seconds) const {
   p["stereo"] = options_.encoder.stereo;
   p["sensitivity"] = options_.sensitivity;
   p["panel"] = options_.panel;
-  p["impl"] = options_.impl;
+  p["method"] = options_.method;
+  p["impl"] = options_.method_impl();
   p["seed"] = options_.seed;
-  if (options_.impl != "reference") p["skip_unneeded"] = !options_.no_skip;
+  if (options_.method_impl() != "reference") p["skip_unneeded"] = !options_.no_skip;
   r["parameters"] = p;
 
   Json s;
   const auto n = static_cast<double>(views_);
   s["views"] = views_;
   s["pixel_ratio"] = sum_full_payload_ > 0 ? sum_payload_ / sum_full_payload_ : 0.0;
+  // Per frame pair against full rate (2 W H each): what the GPU rendered and what the link carried.
+  s["pixels_rendered_ratio"] = sum_pixels_full_ > 0 ? sum_pixels_rendered_ / sum_pixels_full_ : 0.0;
+  s["pixels_sent_ratio"] = sum_pixels_full_ > 0 ? sum_pixels_sent_ / sum_pixels_full_ : 0.0;
+  // Per pair of one eye's views (two view slots).
+  s["pixels_rendered_per_pair"] = views_ > 0 ? 2.0 * sum_pixels_rendered_ / n : 0.0;
+  s["pixels_sent_per_pair"] = views_ > 0 ? 2.0 * sum_pixels_sent_ / n : 0.0;
   s["payload_bytes_total"] = sum_payload_;
   s["mean_clipped_fraction_full"] = full_views_ ? sum_clipped_full_ / static_cast<double>(full_views_) : 0.0;
   s["max_residual_abs"] = max_residual_;
@@ -277,6 +292,9 @@ std::string RunRecorder::summary_table() const {
   row("views decoded", std::to_string(views_));
   row("full / reduced size", std::to_string(full_width_) + "x" + std::to_string(full_height_) + " / " +
                                  std::to_string(reduced_width_) + "x" + std::to_string(reduced_height_));
+  row("method", options_.method);
+  row("pixels rendered / sent vs full",
+      fmt("%.4f", s["pixels_rendered_ratio"].get<double>()) + " / " + fmt("%.4f", s["pixels_sent_ratio"].get<double>()));
   row("link payload vs full rate", fmt("%.4f", s["pixel_ratio"].get<double>()));
   row("full frames clipped (mean)", fmt("%.3f %%", 100.0 * s["mean_clipped_fraction_full"].get<double>()));
   row("max |residual|", fmt("%.4f", max_residual_));
@@ -289,7 +307,7 @@ std::string RunRecorder::summary_table() const {
   }
   row("perceived pair vs full rate (PSNR)", psnr);
   if (vs_reference_.compared > 0) {
-    row(("decoder " + options_.impl + " vs reference").c_str(),
+    row(("decoder " + options_.method_impl() + " vs reference").c_str(),
         fmt("%.4f %% of codes identical", 100.0 * vs_reference_.identical_fraction()) +
             fmt(", max %.0f LSB", vs_reference_.max_lsb) +
             (panel_.kind == PanelKind::Lcd ? " (panel history synchronised)" : ""));

@@ -91,6 +91,7 @@ class RunRecorder {
   std::int64_t skip_lines_full_ = 0;     // output lines of full views (residual-write skips)
   bool have_fixed_counts_ = false;
   double sum_render_ = 0;
+  double sum_pixels_rendered_ = 0, sum_pixels_sent_ = 0, sum_pixels_full_ = 0;
 };
 
 // Rough PSNR (dB) between two linear images, measured on their sRGB encodings scaled to [0, 1];

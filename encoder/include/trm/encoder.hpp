@@ -45,6 +45,9 @@ class TrmEncoder {
   const EncoderConfig& config() const { return config_; }
   // Encodes linear frame t of one eye (CV_64FC3 in [0, 1]) into the view the link carries.
   LinkFrame encode(const cv::Mat& linear_full, std::int64_t t, int eye = 0) const;
+  // The same view at a given parity, whatever parity_of says: the display methods other than TRM send full views
+  // in every slot they send (or derive theirs from one).
+  LinkFrame encode_as(Parity parity, const cv::Mat& linear_full, std::int64_t t, int eye = 0) const;
 
  private:
   EncoderConfig config_;

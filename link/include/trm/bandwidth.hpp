@@ -86,22 +86,26 @@ std::optional<LinkPreset> minimum_fitting_preset(std::uint64_t wire_bits, double
 
 // OUT/frames.csv: one row per link frame. Columns:
 // link_frame,time_s,views,parities,pixel_bits,payload_bits,overhead_bits,wire_bits,packets,
-// wire_time_s,available_time_s,utilisation,fits
+// wire_time_s,available_time_s,utilisation,fits,method
+// `method` names the display method whose views the link frame carried, so that files of several methods' runs can
+// be read together.
 // Rows are streamed to a temporary name in the same directory and renamed on close(), so a reader never
 // sees half a file. Throws std::runtime_error naming the path on an I/O failure; a writer destroyed
 // unclosed removes its temporary file.
 class FramesCsvWriter {
  public:
-  FramesCsvWriter(const std::filesystem::path& path, double refresh_hz);
+  FramesCsvWriter(const std::filesystem::path& path, double refresh_hz, std::string method);
   void add(const LinkFrameUsage& usage);
   void close();
 
  private:
   io::AtomicFile file_;
   double refresh_hz_;
+  std::string method_;
   bool closed_ = false;
 };
-void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz);
+void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz,
+                      const std::string& method);
 
 struct PlotSeries {
   std::string label;

@@ -1,0 +1,193 @@
+#include "method_support.hpp"
+
+#include "trm/resample.hpp"
+#include "trm/transfer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace trm::methods {
+
+PanelShow::PanelShow(const DecoderConfig& config) : config_(config) { config_.validate(); }
+
+DecodedFrame PanelShow::show(const FrameMeta& meta, const cv::Mat& wanted) {
+  cv::Mat drive(wanted.size(), CV_64FC3);
+  for (int y = 0; y < wanted.rows; ++y) {
+    const auto* x_row = wanted.ptr<cv::Vec3d>(y);
+    auto* v_row = drive.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < wanted.cols; ++x) {
+      for (int ch = 0; ch < 3; ++ch) v_row[x][ch] = config_.panel.drive_from_linear(x_row[x][ch], ch);
+    }
+  }
+  cv::Mat codes = quantise(drive, config_.output_bits);
+  return emit(meta, wanted.clone(), std::move(drive), std::move(codes));
+}
+
+DecodedFrame PanelShow::show_received(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
+  check_received(frame, config_, "display method");
+  if (frame.meta.parity != Parity::Full) {
+    throw std::invalid_argument("display method: expected a full view, got a reduced one (t=" +
+                                std::to_string(frame.meta.index) + ")");
+  }
+  if (line_intact.empty()) return show(frame.meta, linear_of_codes(frame.codes, frame.meta));
+  cv::Mat codes = frame.codes.clone();
+  const int concealed = conceal_lost_rows(codes, line_intact);
+  DecodedFrame out = show(frame.meta, linear_of_codes(codes, frame.meta));
+  out.stats.concealed_lines = concealed;
+  return out;
+}
+
+DecodedFrame PanelShow::hold(const FrameMeta& meta) {
+  const auto last = last_.find(meta.eye);
+  if (last == last_.end() || last->second.drive_codes.size() != cv::Size(meta.full_width, meta.full_height)) {
+    return black(meta);
+  }
+  const DecodedFrame& previous = last->second;
+  return emit(meta, previous.wanted_linear.clone(), previous.drive.clone(), previous.drive_codes.clone());
+}
+
+DecodedFrame PanelShow::black(const FrameMeta& meta) {
+  const cv::Size full(meta.full_width, meta.full_height);
+  return emit(meta, cv::Mat::zeros(full, CV_64FC3), cv::Mat::zeros(full, CV_64FC3), cv::Mat::zeros(full, CV_16UC3));
+}
+
+DecodedFrame PanelShow::lost(const FrameMeta& meta) {
+  check_view_meta(meta, "display method: lost view: ");
+  const auto last = last_.find(meta.eye);
+  const bool have = last != last_.end() && last->second.drive_codes.size() == cv::Size(meta.full_width, meta.full_height);
+  DecodedFrame out = have ? hold(meta) : black(meta);
+  out.stats.frame_lost = true;
+  out.stats.concealed_lines = meta.height;
+  return out;
+}
+
+DecodedFrame PanelShow::emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat drive, cv::Mat codes) {
+  DecodedFrame out;
+  out.meta = shown_meta(meta);
+  out.wanted_linear = std::move(wanted);
+  out.drive = std::move(drive);
+  out.drive_codes = std::move(codes);
+  const double top = std::ldexp(1.0, config_.output_bits) - 1.0;
+  const Panel& panel = config_.panel;
+  // An LCD merges frame t with the codes of frame t-1 (the first frame of an eye as if held).
+  const auto last = last_.find(meta.eye);
+  const bool have_previous = last != last_.end() && last->second.drive_codes.size() == out.drive_codes.size();
+  const cv::Mat& previous = have_previous ? last->second.drive_codes : out.drive_codes;
+  out.emitted_linear.create(out.drive_codes.size(), CV_64FC3);
+  for (int y = 0; y < out.drive_codes.rows; ++y) {
+    const auto* q_row = out.drive_codes.ptr<cv::Vec3w>(y);
+    const auto* p_row = previous.ptr<cv::Vec3w>(y);
+    auto* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < out.drive_codes.cols; ++x) {
+      for (int ch = 0; ch < 3; ++ch) {
+        const double v = q_row[x][ch] / top;
+        e_row[x][ch] = panel.kind == PanelKind::Lcd
+                           ? std::pow(std::max(panel.lcd.merge(v, p_row[x][ch] / top), 0.0), panel.lcd.gamma)
+                           : panel.linear_from_drive(v, ch);
+      }
+    }
+  }
+  last_[meta.eye] = out;
+  return out;
+}
+
+void check_received(const LinkFrame& frame, const DecoderConfig& config, const char* method) {
+  const FrameMeta& meta = frame.meta;
+  const std::string where = std::string(method) + ": view t=" + std::to_string(meta.index) + " eye " +
+                            std::to_string(meta.eye) + ": ";
+  check_view_meta(meta, where);
+  if (meta.bits != config.link.bits || meta.transfer != config.link.transfer) {
+    throw std::invalid_argument(where + "sent with " + std::to_string(meta.bits) + " bits, " + to_string(meta.transfer) +
+                                "; the display expects " + std::to_string(config.link.bits) + " bits, " +
+                                to_string(config.link.transfer));
+  }
+  if (frame.codes.type() != CV_16UC3 || frame.codes.cols != meta.width || frame.codes.rows != meta.height) {
+    throw std::invalid_argument(where + "codes must be CV_16UC3 of " + std::to_string(meta.width) + "x" +
+                                std::to_string(meta.height));
+  }
+  double highest = 0.0;
+  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
+  if (highest > std::ldexp(1.0, meta.bits) - 1.0) {
+    throw std::invalid_argument(where + "code " + std::to_string(static_cast<int>(highest)) + " exceeds " +
+                                std::to_string(meta.bits) + " bits");
+  }
+}
+
+FullViewSender::FullViewSender(const EncoderConfig& link, bool every_slot) : encoder_(link), every_slot_(every_slot) {}
+
+bool FullViewSender::sends(std::int64_t t, int eye) const {
+  return every_slot_ || parity_of(t, eye, encoder_.config()) == Parity::Full;
+}
+
+Transmission FullViewSender::send(const cv::Mat& linear, std::int64_t t, int eye) {
+  Transmission out;
+  out.frame = encoder_.encode_as(Parity::Full, linear, t, eye);
+  out.pixels_rendered = static_cast<std::int64_t>(out.frame.codes.total());
+  return out;
+}
+
+TrmFrameDisplay::TrmFrameDisplay(const std::string& impl, const FixedDecoderConfig& config)
+    : decoder_(make_decoder(impl, config)) {}
+
+DecodedFrame TrmFrameDisplay::show(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
+  return line_intact.empty() ? decoder_->decode(frame) : decoder_->decode(frame, line_intact);
+}
+
+DecodedFrame TrmFrameDisplay::show_lost(const FrameMeta& slot) { return decoder_->decode_lost(slot); }
+
+DecodedFrame TrmFrameDisplay::show_unsent(const FrameMeta&) {
+  throw std::logic_error("a TRM-frame method sends every view");
+}
+
+FrameMeta FullViewSender::view_meta(std::int64_t t, int eye, cv::Size full) const {
+  return view_meta_of(t, eye, Parity::Full, full, full, encoder_.config());
+}
+
+FrameMeta trm_view_meta(std::int64_t t, int eye, cv::Size full, const EncoderConfig& link) {
+  const Parity parity = parity_of(t, eye, link);
+  const cv::Size sent = parity == Parity::Full ? full
+                                               : cv::Size(reduced_size(full.width, link.reduction),
+                                                          reduced_size(full.height, link.reduction));
+  return view_meta_of(t, eye, parity, sent, full, link);
+}
+
+void require_no_option(const MethodSetup& setup, const char* method) {
+  if (!setup.option.empty()) {
+    throw std::invalid_argument(std::string("method '") + method + "' takes no option, got '" + setup.option + "'");
+  }
+}
+
+cv::Mat linear_of_codes(const cv::Mat& codes, const FrameMeta& meta) {
+  return to_linear(dequantise(codes, meta.bits), meta.transfer);
+}
+
+int conceal_lost_rows(cv::Mat& codes, std::span<const std::uint8_t> line_intact) {
+  if (line_intact.size() != static_cast<std::size_t>(codes.rows)) {
+    throw std::invalid_argument("display method: line mask has " + std::to_string(line_intact.size()) +
+                                " entries for a view of " + std::to_string(codes.rows) + " lines");
+  }
+  int first_intact = -1;
+  for (int y = 0; y < codes.rows && first_intact < 0; ++y) {
+    if (line_intact[static_cast<std::size_t>(y)]) first_intact = y;
+  }
+  if (first_intact < 0) throw std::invalid_argument("display method: a view with no intact line is a lost view");
+  int concealed = 0;
+  for (int y = 0; y < codes.rows; ++y) {
+    if (line_intact[static_cast<std::size_t>(y)]) continue;
+    // Rows above y are already concealed, so the row just above holds the nearest intact row above.
+    codes.row(y > first_intact ? y - 1 : first_intact).copyTo(codes.row(y));
+    ++concealed;
+  }
+  return concealed;
+}
+
+FrameMeta shown_meta(const FrameMeta& sent) {
+  FrameMeta meta = sent;
+  meta.width = sent.full_width;
+  meta.height = sent.full_height;
+  return meta;
+}
+
+}  // namespace trm::methods
