@@ -355,3 +355,67 @@ TEST(Cli, CaptureReplaysIntoDecodeAndFeed) {
   EXPECT_FALSE(fs::exists(tmp.path() / "cutdec"));
   EXPECT_NE(run_trm("run --frames 2 --size 8x8 --link custom:0:0.8 --out " + tmp.str("zero")).exit_code, 0);
 }
+
+// Every display method goes over the same link, faults included, and says what it rendered and sent.
+TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFrame) {
+  TempDir tmp;
+  const Result list = run_trm("methods");
+  ASSERT_EQ(list.exit_code, 0) << list.output;
+  const std::vector<std::pair<std::string, double>> methods = {
+      {"trm", 0.625}, {"full", 1.0}, {"half-rate", 0.5}, {"interlace", 0.5}, {"interlace:double", 0.5}, {"bfi", 0.5},
+      {"ncsfi", 0.625}};
+  for (const auto& [method, sent_ratio] : methods) {
+    EXPECT_NE(list.output.find(method.substr(0, method.find(':'))), std::string::npos) << method;
+    const std::string out = tmp.str("run-" + method.substr(0, method.find(':')) + std::to_string(method.size()));
+    const Result run = run_trm("run --method " + method + " --frames 6 --size 32x24 --link dp1.2 --drop 0.02 --seed 5 --out " + out);
+    ASSERT_EQ(run.exit_code, 0) << method << "\n" << run.output;
+    std::ifstream in(out + "/report.json");
+    const nlohmann::json report = nlohmann::json::parse(in);
+    EXPECT_EQ(report["parameters"]["method"], method);
+    EXPECT_EQ(report["link"]["method"], method);
+    EXPECT_DOUBLE_EQ(report["summary"]["pixels_sent_ratio"].get<double>(), sent_ratio) << method;
+    EXPECT_GT(report["link"]["average_payload_bits"].get<double>(), 0.0) << method;
+    // frames.csv: one row per link frame, each naming the method, payload bits as carried.
+    std::ifstream csv(out + "/frames.csv");
+    std::string header, row;
+    std::getline(csv, header);
+    EXPECT_EQ(header.substr(header.rfind(',') + 1), "method");
+    int rows = 0;
+    while (std::getline(csv, row)) {
+      EXPECT_EQ(row.substr(row.rfind(',') + 1), method) << row;
+      ++rows;
+    }
+    EXPECT_EQ(rows, 6) << method;
+    // The plain-frame methods are decoded by the reference; TRM's family by the hardware model.
+    const bool fixed = method == "trm" || method == "ncsfi";
+    EXPECT_EQ(report["parameters"]["impl"], fixed ? "fixed" : "reference") << method;
+  }
+}
+
+// A capture records its method; replay tells slots the method never sent from views the link lost.
+TEST(Cli, CaptureOfAHalfRateRunReplaysWithItsUnsentSlots) {
+  TempDir tmp;
+  const Result run = run_trm("run --method half-rate --frames 6 --size 32x24 --link dp1.2 --out " + tmp.str("run"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Result decode = run_trm("decode --capture " + tmp.str("run/link.trmcap") + " --out " + tmp.str("dec"));
+  ASSERT_EQ(decode.exit_code, 0) << decode.output;
+  const auto views = read_json_lines(tmp.path() / "dec" / "views.jsonl");
+  ASSERT_EQ(views.size(), 6u);
+  for (const auto& v : views) {
+    const bool sent = v["t"].get<int>() % 2 == 0;
+    EXPECT_EQ(v["sent"], sent) << v.dump();
+    EXPECT_EQ(v["lost"], false) << v.dump();
+  }
+  // The repeat is the rendered frame again, code for code.
+  const cv::Mat shown = cv::imread(tmp.str("dec/drive8_0002.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat repeated = cv::imread(tmp.str("dec/drive8_0003.png"), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(shown.empty() || repeated.empty());
+  EXPECT_EQ(cv::norm(shown, repeated, cv::NORM_INF), 0.0);
+  std::ifstream in(tmp.str("dec/report.json"));
+  EXPECT_EQ(nlohmann::json::parse(in)["parameters"]["method"], "half-rate");
+  // The fixed-point decoder is refused for a plain-frame capture, with the capture's name.
+  const Result fixed = run_trm("decode --impl fixed --capture " + tmp.str("run/link.trmcap") + " --out " + tmp.str("f"));
+  EXPECT_NE(fixed.exit_code, 0);
+  EXPECT_NE(fixed.output.find("half-rate"), std::string::npos) << fixed.output;
+  EXPECT_FALSE(fs::exists(tmp.path() / "f"));
+}
