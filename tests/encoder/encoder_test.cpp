@@ -1,5 +1,6 @@
 // The TRM encoder: parity, reduced frame = Q_b(D(E_q)) of the quantised full frame, metadata.
 #include "trm/encoder.hpp"
+#include "trm/encoder_json.hpp"
 
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
@@ -7,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace trm {
 namespace {
@@ -176,3 +179,42 @@ TEST(TrmEncoder, RejectsInvalidFrames) {
 
 }  // namespace
 }  // namespace trm
+
+// One writer and one reader of the encoder configuration (capture headers, reports).
+TEST(EncoderJson, RoundTripsAndRefusesWhatTheCommandLineWouldRefuse) {
+  trm::EncoderConfig config;
+  config.reduction = 0.25;
+  config.phase = 1;
+  config.transfer = trm::Transfer::Gamma22;
+  config.resample_space = trm::ResampleSpace::Linear;
+  config.bits = 10;
+  config.stereo = true;
+  const nlohmann::ordered_json j = trm::encoder_json(config);
+  EXPECT_EQ(j["sigma"].get<double>(), 5.0);  // the effective sigma, 1.25 / r
+  const trm::EncoderConfig back = trm::encoder_config_from_json(j);
+  EXPECT_EQ(back.reduction, config.reduction);
+  EXPECT_EQ(back.effective_sigma(), config.effective_sigma());
+  EXPECT_EQ(back.phase, 1);
+  EXPECT_EQ(back.transfer, trm::Transfer::Gamma22);
+  EXPECT_EQ(back.resample_space, trm::ResampleSpace::Linear);
+  EXPECT_EQ(back.bits, 10);
+  EXPECT_TRUE(back.stereo);
+  EXPECT_EQ(trm::encoder_json(back), j);
+  for (const char* field : {"reduction", "sigma", "phase", "transfer", "resample_space", "bits", "stereo"}) {
+    nlohmann::json missing = j;
+    missing.erase(field);
+    try {
+      (void)trm::encoder_config_from_json(missing);
+      ADD_FAILURE() << "accepted a configuration without " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  }
+  nlohmann::json bad = j;
+  bad["bits"] = 9;
+  EXPECT_THROW((void)trm::encoder_config_from_json(bad), std::invalid_argument);
+  bad = j;
+  bad["reduction"] = "half";
+  EXPECT_THROW((void)trm::encoder_config_from_json(bad), std::invalid_argument);
+  EXPECT_THROW((void)trm::encoder_config_from_json(nlohmann::json::array()), std::invalid_argument);
+}

@@ -5,6 +5,7 @@
 #include "output_dir.hpp"
 
 #include "trm/atomic_file.hpp"
+#include "trm/encoder_json.hpp"
 
 #include <iostream>
 #include <memory>
@@ -30,11 +31,8 @@ void register_hw_report(CLI::App& app, Action& action) {
       const FixedStreamingDecoder decoder(config);  // validates the configuration
       Json report;
       report["parameters"] = {{"size", {options->width, options->height}},
-                              {"reduction", options->encoder.reduction},
-                              {"sigma", options->encoder.effective_sigma()},
+                              {"encoder", encoder_json(options->encoder)},
                               {"panel", options->panel},
-                              {"resample_space", to_string(options->encoder.resample_space)},
-                              {"link_bits", options->encoder.bits},
                               {"output_bits", options->output_bits},
                               {"residual_format", config.residual.to_string()},
                               {"linear_frac_bits", config.linear_frac_bits}};

@@ -6,6 +6,7 @@
 #include "vectors.hpp"
 
 #include "trm/atomic_file.hpp"
+#include "trm/encoder_json.hpp"
 
 #include <cstdio>
 #include <iostream>
@@ -44,9 +45,8 @@ void register_vectors(CLI::App& app, Action& action) {
       report["parameters"] = {{"scene", options->scene},
                               {"size", {options->width, options->height}},
                               {"frames", options->frames},
-                              {"reduction", options->encoder.reduction},
+                              {"encoder", encoder_json(options->encoder)},
                               {"panel", options->panel},
-                              {"link_bits", options->encoder.bits},
                               {"output_bits", options->output_bits}};
       Json files = Json::array();
       OutputDir dir(*out);

@@ -2,6 +2,7 @@
 
 #include "hw_report.hpp"
 
+#include "trm/encoder_json.hpp"
 #include "trm/resample.hpp"
 
 #include <nlohmann/json.hpp>
@@ -32,15 +33,8 @@ bool looks_like_image_sequence(const std::string& input) {
 
 // Stored in a capture's header so that `trm decode --capture` can rebuild the decoder's link configuration.
 std::string capture_metadata(const PipelineOptions& options, std::int64_t frames) {
-  nlohmann::ordered_json meta;
+  nlohmann::ordered_json meta = encoder_json(options.encoder);
   meta["method"] = options.method;
-  meta["reduction"] = options.encoder.reduction;
-  meta["sigma"] = options.encoder.effective_sigma();
-  meta["phase"] = options.encoder.phase;
-  meta["transfer"] = to_string(options.encoder.transfer);
-  meta["resample_space"] = to_string(options.encoder.resample_space);
-  meta["bits"] = options.encoder.bits;
-  meta["stereo"] = options.encoder.stereo;
   meta["refresh_hz"] = options.refresh_hz;
   meta["frames"] = frames;  // link frames the run sends: views lost at the end of a capture are known too
   return meta.dump();
@@ -464,15 +458,7 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
   EncoderConfig& link = capture_options.encoder;
   std::optional<std::int64_t> frames_sent;
   try {
-    if (!meta.is_object()) throw std::invalid_argument("the header's configuration is not a JSON object");
-    link.reduction = meta.at("reduction").get<double>();
-    link.sigma = meta.at("sigma").get<double>();
-    link.phase = meta.at("phase").get<int>();
-    link.transfer = parse_transfer(meta.at("transfer").get<std::string>());
-    link.resample_space = parse_resample_space(meta.at("resample_space").get<std::string>());
-    link.bits = meta.at("bits").get<int>();
-    link.stereo = meta.at("stereo").get<bool>();
-    link.validate();
+    link = encoder_config_from_json(meta);
     validate_refresh_hz(meta.at("refresh_hz").get<double>(), "refresh_hz");
     if (meta.contains("frames")) {
       frames_sent = meta.at("frames").get<std::int64_t>();

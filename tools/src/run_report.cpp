@@ -1,5 +1,6 @@
 #include "run_report.hpp"
 
+#include "trm/encoder_json.hpp"
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
@@ -219,14 +220,8 @@ Json RunRecorder::report(double wall_seconds) const {
   p["size"] = {full_width_, full_height_};
   p["reduced_size"] = {reduced_width_, reduced_height_};
   p["refresh_hz"] = options_.refresh_hz;
-  p["reduction"] = options_.encoder.reduction;
-  p["sigma"] = options_.encoder.effective_sigma();
-  p["phase"] = options_.encoder.phase;
-  p["transfer"] = to_string(options_.encoder.transfer);
-  p["resample_space"] = to_string(options_.encoder.resample_space);
-  p["link_bits"] = options_.encoder.bits;
+  p["encoder"] = encoder_json(options_.encoder);
   p["output_bits"] = options_.output_bits;
-  p["stereo"] = options_.encoder.stereo;
   p["sensitivity"] = options_.sensitivity;
   p["panel"] = options_.panel;
   p["method"] = options_.method;
