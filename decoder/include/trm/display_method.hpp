@@ -12,6 +12,7 @@
 #include "trm/frame.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -72,11 +73,12 @@ class MethodDisplay {
 struct DisplayMethod {
   std::string name;
   std::string summary;               // one line for `trm methods`
-  std::string option_help;           // what ":OPTION" may be ("" when the method takes none)
+  std::string option_help;           // what ":OPTION" may be ("" when the method takes none: find_display_method
+                                     // then refuses any)
   bool fixed_point = false;          // its headset side decodes TRM frames with any decoder of make_decoder()
-  // Throws std::invalid_argument for an option the method does not know.
-  std::unique_ptr<MethodSender> (*make_sender)(const MethodSetup& setup) = nullptr;
-  std::unique_ptr<MethodDisplay> (*make_display)(const MethodSetup& setup) = nullptr;
+  // Each throws std::invalid_argument for an option the method does not know.
+  std::function<std::unique_ptr<MethodSender>(const MethodSetup& setup)> make_sender;
+  std::function<std::unique_ptr<MethodDisplay>(const MethodSetup& setup)> make_display;
 };
 
 // Every method, in the order `trm methods` lists them.

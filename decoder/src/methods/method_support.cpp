@@ -153,10 +153,54 @@ FrameMeta trm_view_meta(std::int64_t t, int eye, cv::Size full, const EncoderCon
   return view_meta_of(t, eye, parity, sent, full, link);
 }
 
-void require_no_option(const MethodSetup& setup, const char* method) {
-  if (!setup.option.empty()) {
-    throw std::invalid_argument(std::string("method '") + method + "' takes no option, got '" + setup.option + "'");
+namespace {
+
+class PlainFrameDisplay : public MethodDisplay {
+ public:
+  PlainFrameDisplay(const DecoderConfig& config, Between between) : panel_(config), between_(between) {}
+  DecodedFrame show(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) override {
+    return panel_.show_received(frame, line_intact);
   }
+  DecodedFrame show_lost(const FrameMeta& slot) override { return panel_.lost(slot); }
+  DecodedFrame show_unsent(const FrameMeta& slot) override {
+    switch (between_) {
+      case Between::Repeat: return panel_.hold(slot);
+      case Between::Black: return panel_.black(slot);
+      case Between::Nothing: break;
+    }
+    throw std::logic_error("a method that sends every view was asked for an unsent one");
+  }
+
+ private:
+  PanelShow panel_;
+  Between between_;
+};
+
+}  // namespace
+
+DisplayMethod trm_frame_method(std::string name, std::string summary, SenderFactory sender, HeadsetConfig headset) {
+  DisplayMethod m;
+  m.name = std::move(name);
+  m.summary = std::move(summary);
+  m.fixed_point = true;
+  m.make_sender = [sender](const MethodSetup& setup) { return sender(setup.decoder.decoder.link); };
+  m.make_display = [headset](const MethodSetup& setup) -> std::unique_ptr<MethodDisplay> {
+    return std::make_unique<TrmFrameDisplay>(setup.impl, headset(setup.decoder));
+  };
+  return m;
+}
+
+DisplayMethod plain_frame_method(std::string name, std::string summary, Between between) {
+  DisplayMethod m;
+  m.name = std::move(name);
+  m.summary = std::move(summary);
+  m.make_sender = [between](const MethodSetup& setup) -> std::unique_ptr<MethodSender> {
+    return std::make_unique<FullViewSender>(setup.decoder.decoder.link, between == Between::Nothing);
+  };
+  m.make_display = [between](const MethodSetup& setup) -> std::unique_ptr<MethodDisplay> {
+    return std::make_unique<PlainFrameDisplay>(setup.decoder.decoder, between);
+  };
+  return m;
 }
 
 cv::Mat linear_of_codes(const cv::Mat& codes, const FrameMeta& meta) {

@@ -9,6 +9,7 @@
 #include "trm/display_method.hpp"
 #include "trm/encoder.hpp"
 
+#include <functional>
 #include <map>
 #include <span>
 
@@ -70,8 +71,22 @@ class TrmFrameDisplay : public MethodDisplay {
 // The metadata of TRM's view (t, eye): full or reduced by TRM's parity rule (trm and ncsfi send these).
 FrameMeta trm_view_meta(std::int64_t t, int eye, cv::Size full, const EncoderConfig& link);
 
-// Throws std::invalid_argument unless a method that takes no option got none.
-void require_no_option(const MethodSetup& setup, const char* method);
+// A method whose views are TRM frames, shown by the TRM decoder of --impl (fixed_point = true): its sender, and the
+// decoder configuration its headset side uses (the run's, or adjusted, e.g. ncsfi's s = 0).
+using SenderFactory = std::function<std::unique_ptr<MethodSender>(const EncoderConfig& link)>;
+using HeadsetConfig = std::function<FixedDecoderConfig(FixedDecoderConfig)>;
+DisplayMethod trm_frame_method(std::string name, std::string summary, SenderFactory sender,
+                               HeadsetConfig headset = [](FixedDecoderConfig c) { return c; });
+
+// What a plain-frame method shows in the slots between its rendered frames.
+enum class Between {
+  Nothing,  // there are none: every slot is rendered and sent
+  Repeat,   // the last frame again, code for code
+  Black,    // a black frame
+};
+// A method that renders and sends whole frames (every slot, or TRM's full slots only) and shows them through
+// PanelShow: full, half-rate, bfi differ only in `between`.
+DisplayMethod plain_frame_method(std::string name, std::string summary, Between between);
 
 // Linear light of received link codes (the view's transfer function), CV_64FC3.
 cv::Mat linear_of_codes(const cv::Mat& codes, const FrameMeta& meta);

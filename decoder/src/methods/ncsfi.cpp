@@ -60,19 +60,9 @@ FixedDecoderConfig always_add_residual(FixedDecoderConfig config) {
 }  // namespace
 
 DisplayMethod ncsfi_method() {
-  DisplayMethod m;
-  m.name = "ncsfi";
-  m.summary = "NCSFI (Sec. 8): each rendered frame shown sharpened then blurred, residual always added (s = 0)";
-  m.fixed_point = true;
-  m.make_sender = [](const MethodSetup& setup) -> std::unique_ptr<MethodSender> {
-    require_no_option(setup, "ncsfi");
-    return std::make_unique<NcsfiSender>(setup.decoder.decoder.link);
-  };
-  m.make_display = [](const MethodSetup& setup) -> std::unique_ptr<MethodDisplay> {
-    require_no_option(setup, "ncsfi");
-    return std::make_unique<TrmFrameDisplay>(setup.impl, always_add_residual(setup.decoder));
-  };
-  return m;
+  return trm_frame_method(
+      "ncsfi", "NCSFI (Sec. 8): each rendered frame shown sharpened then blurred, residual always added (s = 0)",
+      [](const EncoderConfig& link) { return std::make_unique<NcsfiSender>(link); }, always_add_residual);
 }
 
 }  // namespace trm::methods

@@ -29,10 +29,12 @@ MethodChoice find_display_method(const std::string& spec) {
     if (choice.option.empty()) throw std::invalid_argument("method '" + spec + "': empty option after ':'");
   }
   for (const DisplayMethod& method : display_methods()) {
-    if (method.name == name) {
-      choice.method = &method;
-      return choice;
+    if (method.name != name) continue;
+    if (method.option_help.empty() && !choice.option.empty()) {
+      throw std::invalid_argument("method '" + name + "' takes no option, got '" + choice.option + "'");
     }
+    choice.method = &method;
+    return choice;
   }
   std::string list;
   for (const DisplayMethod& method : display_methods()) list += (list.empty() ? "" : ", ") + method.name;

@@ -29,19 +29,9 @@ class TrmSender : public MethodSender {
 }  // namespace
 
 DisplayMethod trm_method() {
-  DisplayMethod m;
-  m.name = "trm";
-  m.summary = "Temporal Resolution Multiplexing: full and reduced frames alternate ((1 + r^2) / 2 of the pixels)";
-  m.fixed_point = true;
-  m.make_sender = [](const MethodSetup& setup) -> std::unique_ptr<MethodSender> {
-    require_no_option(setup, "trm");
-    return std::make_unique<TrmSender>(setup.decoder.decoder.link);
-  };
-  m.make_display = [](const MethodSetup& setup) -> std::unique_ptr<MethodDisplay> {
-    require_no_option(setup, "trm");
-    return std::make_unique<TrmFrameDisplay>(setup.impl, setup.decoder);
-  };
-  return m;
+  return trm_frame_method(
+      "trm", "Temporal Resolution Multiplexing: full and reduced frames alternate ((1 + r^2) / 2 of the pixels)",
+      [](const EncoderConfig& link) { return std::make_unique<TrmSender>(link); });
 }
 
 }  // namespace trm::methods
