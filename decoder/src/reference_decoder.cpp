@@ -10,6 +10,7 @@
 #include "trm/reference_decoder.hpp"
 
 #include "lost_view.hpp"
+#include "view_arrival.hpp"
 
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
@@ -34,54 +35,6 @@ constexpr double kLumaG = 0.7152;
 constexpr double kLumaB = 0.0722;
 
 int max_code(int bits) { return (1 << bits) - 1; }
-
-std::string frame_name(const FrameMeta& meta) {
-  return std::string(to_string(meta.parity)) + " frame t=" + std::to_string(meta.index) +
-         " eye=" + std::to_string(meta.eye);
-}
-
-// ---------------------------------------------------------------------------------------------------------
-// Input checks: everything the stages below rely on.
-
-void check_link_frame(const LinkFrame& frame, const DecoderConfig& config) {
-  const FrameMeta& meta = frame.meta;
-  const std::string what = "ReferenceDecoder: " + frame_name(meta) + ": ";
-  check_view_meta(meta, what);
-  if (meta.bits != config.link.bits) {
-    throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
-                                std::to_string(config.link.bits));
-  }
-  if (meta.transfer != config.link.transfer) {
-    throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
-                                to_string(config.link.transfer));
-  }
-  if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
-    throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
-  }
-  if (frame.codes.cols != meta.width || frame.codes.rows != meta.height) {
-    throw std::invalid_argument(what + "codes are " + std::to_string(frame.codes.cols) + "x" +
-                                std::to_string(frame.codes.rows) + " but the metadata says " +
-                                std::to_string(meta.width) + "x" + std::to_string(meta.height));
-  }
-  const cv::Size full(meta.full_width, meta.full_height);
-  const cv::Size expected = meta.parity == Parity::Full
-                                ? full
-                                : cv::Size(reduced_size(full.width, config.link.reduction),
-                                           reduced_size(full.height, config.link.reduction));
-  if (frame.codes.size() != expected) {
-    throw std::invalid_argument(what + "codes are " + std::to_string(frame.codes.cols) + "x" +
-                                std::to_string(frame.codes.rows) + " but a " + to_string(meta.parity) +
-                                " frame of a " + std::to_string(full.width) + "x" + std::to_string(full.height) +
-                                " view at r=" + std::to_string(config.link.reduction) + " must be " +
-                                std::to_string(expected.width) + "x" + std::to_string(expected.height));
-  }
-  double highest = 0.0;
-  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
-  if (highest > max_code(config.link.bits)) {
-    throw std::invalid_argument(what + "code " + std::to_string(static_cast<int>(highest)) + " exceeds the " +
-                                std::to_string(config.link.bits) + "-bit range");
-  }
-}
 
 // ---------------------------------------------------------------------------------------------------------
 // Stages shared by both parities.
@@ -434,33 +387,6 @@ void DecoderConfig::validate() const {
 
 ReferenceDecoder::ReferenceDecoder(DecoderConfig config) : config_(std::move(config)) { config_.validate(); }
 
-namespace {
-
-// Replaces every lost row of codes: by the same row of `substitute` when given, else by the nearest intact row
-// above (or below when there is none above). Returns the number of rows replaced.
-int conceal_rows(cv::Mat& codes, std::span<const std::uint8_t> intact, const cv::Mat& substitute) {
-  int concealed = 0;
-  for (int y = 0; y < codes.rows; ++y) {
-    if (intact[static_cast<std::size_t>(y)]) continue;
-    ++concealed;
-    if (!substitute.empty()) {
-      substitute.row(y).copyTo(codes.row(y));
-      continue;
-    }
-    int source = -1;
-    for (int up = y - 1; up >= 0 && source < 0; --up) {
-      if (intact[static_cast<std::size_t>(up)]) source = up;
-    }
-    for (int down = y + 1; down < codes.rows && source < 0; ++down) {
-      if (intact[static_cast<std::size_t>(down)]) source = down;
-    }
-    codes.row(source).copyTo(codes.row(y));
-  }
-  return concealed;
-}
-
-}  // namespace
-
 DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
   const cv::Size full(meta.full_width, meta.full_height);
   DecodedFrame out;
@@ -483,27 +409,21 @@ DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
 }
 
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
-  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(frame_name(meta)).append(": "));
+  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(detail::frame_name(meta)).append(": "));
   return detail::hold_lost_view(eyes_[meta.eye], meta);
 }
 
 DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  if (line_intact.empty()) return decode(frame);
-  if (line_intact.size() != static_cast<std::size_t>(frame.codes.rows)) {
-    throw std::invalid_argument("ReferenceDecoder: line mask has " + std::to_string(line_intact.size()) +
-                                " entries for a view of " + std::to_string(frame.codes.rows) + " lines");
+  detail::Concealment lost;
+  switch (detail::classify_arrival(frame, line_intact, lost, "ReferenceDecoder")) {
+    case detail::Arrival::Whole: return decode(frame);
+    case detail::Arrival::Lost: return decode_lost(frame.meta);
+    case detail::Arrival::Partial: break;
   }
-  const auto intact_lines = std::count_if(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
-  if (intact_lines == 0) return decode_lost(frame.meta);
-  if (intact_lines == frame.codes.rows) return decode(frame);
-
-  LinkFrame concealed{frame.meta, frame.codes.clone()};
-  const EyeState& eye = eyes_[frame.meta.eye];
-  const bool reduced = frame.meta.parity == Parity::Reduced;
-  const bool have_low = reduced && eye.have_residual && eye.previous_low.size() == frame.codes.size();
-  const int lines = conceal_rows(concealed.codes, line_intact, have_low ? eye.previous_low : cv::Mat());
+  lost.substitute = detail::concealment_substitute(eyes_, frame);
+  const LinkFrame concealed{frame.meta, detail::concealed_codes(frame.codes, lost)};
   DecodedFrame out = decode_view(concealed, line_intact);
-  out.stats.concealed_lines = lines;
+  out.stats.concealed_lines = lost.lost_lines;
   return out;
 }
 
@@ -532,7 +452,7 @@ void ReferenceDecoder::adopt_panel_history(const DecodedFrame& shown) {
 }
 
 DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  check_link_frame(frame, config_);
+  detail::check_link_frame(frame, config_.link, "ReferenceDecoder");
   const FrameMeta& meta = frame.meta;
   const EncoderConfig& link = config_.link;
   const cv::Size full(meta.full_width, meta.full_height);

@@ -268,6 +268,8 @@ struct FixedStageTaps {
 
 namespace fixed_detail {
 class FixedDecoderCore;
+}
+namespace detail {
 struct Concealment;
 }
 
@@ -296,7 +298,7 @@ class FixedFrameDecoder : public HeadsetDecoder {
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps, const fixed_detail::Concealment* lost);
+  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps, const detail::Concealment* lost);
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
@@ -325,7 +327,7 @@ class FixedStreamingDecoder : public HeadsetDecoder {
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, const fixed_detail::Concealment* lost);
+  DecodedFrame decode_impl(const LinkFrame& frame, const detail::Concealment* lost);
 };
 
 }  // namespace trm
