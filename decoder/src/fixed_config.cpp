@@ -29,7 +29,7 @@ void require_range(const std::string& stage, const char* what, int value, int lo
 void FixedDecoderConfig::validate() const {
   decoder.validate();
   const EncoderConfig& link = decoder.link;
-  if (decoder.panel.kind == PanelKind::Lcd) {
+  if (decoder.panel.has_history()) {
     // The panel itself is valid (decoder.validate); what the sQ7.F coefficient registers hold must still be a
     // merge increasing in v_t, or the threshold search has no answer (a p3 below half an LSB rounds to 0).
     const LcdPanel& lcd = decoder.panel.lcd;
@@ -40,7 +40,7 @@ void FixedDecoderConfig::validate() const {
     Panel quantised = decoder.panel;
     quantised.lcd = held_in_registers;
     try {
-      validate_panel(quantised, "");
+      quantised.validate("");
     } catch (const std::invalid_argument& e) {
       reject("LCD drive (merge coefficients " + coefficient.to_string() + ")",
              std::string("the coefficients as the registers hold them break a rule: ") + e.what() +
@@ -98,11 +98,7 @@ void FixedDecoderConfig::validate() const {
   }
   // The threshold ROM must tell every drive code apart: T_1 < T_2 < ... on the linear grid.
   const int top = (1 << decoder.output_bits) - 1;
-  const std::array<double, 3> gammas = decoder.panel.kind == PanelKind::Oled
-                                           ? decoder.panel.oled.gamma
-                                           : std::array<double, 3>{decoder.panel.lcd.gamma, decoder.panel.lcd.gamma,
-                                                                   decoder.panel.lcd.gamma};
-  for (double gamma : gammas) {
+  for (double gamma : decoder.panel.channel_gammas()) {
     const double t1 = std::ceil(std::ldexp(std::pow(0.5 / top, gamma), linear_frac_bits));
     const double t2 = std::ceil(std::ldexp(std::pow(1.5 / top, gamma), linear_frac_bits));
     if (!(t1 >= 1.0 && t2 > t1)) {

@@ -54,7 +54,7 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
     const std::uint16_t code = kernels_.drive_code(wanted, ch);
     out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(kernels_.drive_value(wanted, ch));
     out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = code;
-    out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted_of_code(code, ch);
+    out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(code, 0, ch);
     return 0;
   }
   // LCD frame stores: v_{t-1} and x_{t-1} at this sample are read, then replaced by this frame's.
@@ -65,7 +65,7 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
   out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = s.code;
   out.tally.counts.lcd_unreachable += s.unreachable ? 1 : 0;
   const bool contributed = config().decoder.lcd_history == LcdHistory::Contributed;
-  out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.lcd_emitted(s.code, s.previous_code);
+  out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(s.code, s.previous_code, ch);
   previous_code = s.code;
   previous_linear = static_cast<std::int32_t>(contributed ? s.contributed : wanted);
   return out.full ? s.shortfall : 0;

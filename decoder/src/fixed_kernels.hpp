@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -123,7 +124,6 @@ class FixedKernels {
   // LCD (Eq. 7 inverse): the drive code whose merge with v_{t-1} = previous_code reaches m = ((x_t + x_{t-1})/2)^(1/g).
   // held: the eye's first frame, x_{t-1} = x_t and the pixel held (M(v, v)); returns the held code.
   LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const;
-  double lcd_emitted(std::uint16_t code, std::uint16_t previous_code) const;
 
   // Rec. 709 luma of linear RGB (uQ1.F each); uQ1.F.
   Raw luma(const Raw* rgb) const;
@@ -146,7 +146,10 @@ class FixedKernels {
   std::uint16_t drive_code(Raw linear, int ch) const;
   // Drive value v = x^(1/gamma) for reports, uQ1.drive_frac_bits.
   Raw drive_value(Raw linear, int ch) const;
-  double emitted_of_code(std::uint16_t code, int ch) const { return emission_[ch][code]; }
+  // The light drive code `code` emits after `previous_code` (read only for a panel with history).
+  double emitted(std::uint16_t code, std::uint16_t previous_code, int ch) const {
+    return (*emission_)(code, previous_code, ch);
+  }
 
   // Every ROM of this configuration (name, words, word bits, copies).
   std::vector<FixedRomReport> roms() const;
@@ -175,7 +178,7 @@ class FixedKernels {
   std::array<std::vector<Raw>, 3> thresholds_;  // T_k, k = 0..2^o - 1 (T_0 = 0)
   std::array<std::unique_ptr<fx::InterpolatedLut>, 3> drive_luts_;
   int drive_lut_shift_ = 0;  // linear LSBs dropped to address the drive LUT (24 address bits at most)
-  std::array<std::vector<double>, 3> emission_;
+  std::optional<PanelEmission> emission_;  // built once the configuration is valid
   double linear_lsb_ = 0.0;
   double drive_lsb_ = 0.0;
   double residual_lsb_ = 0.0;

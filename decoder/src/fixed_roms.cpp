@@ -86,7 +86,8 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
   const int top = max_output_code();
   drive_lut_shift_ = std::max(0, F - 24);
   const int drive_address_bits = F - drive_lut_shift_;
-  lcd_ = config_.decoder.panel.kind == PanelKind::Lcd;
+  emission_.emplace(config_.decoder.panel, config_.decoder.output_bits);
+  lcd_ = config_.decoder.panel.has_history();
   if (lcd_) {
     // LCD (Eq. 7 inverse): coefficients sQ7.F, the target LUT x^(1/gamma) and the clamped-drive luminance ROMs.
     const LcdPanel& lcd = config_.decoder.panel.lcd;
@@ -108,22 +109,23 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
       std::vector<Raw>& rom = lcd_end_luminance_[static_cast<std::size_t>(end)];
       rom.resize(static_cast<std::size_t>(top) + 1);
       for (int j = 0; j <= top; ++j) {
-        const double merged = lcd.merge(static_cast<double>(end), static_cast<double>(j) / top);
-        rom[static_cast<std::size_t>(j)] = fx::quantise_double(std::pow(std::max(merged, 0.0), lcd.gamma), luminance);
+        rom[static_cast<std::size_t>(j)] =
+            fx::quantise_double(lcd.emitted(static_cast<double>(end), static_cast<double>(j) / top), luminance);
       }
     }
     return;
   }
-  // OLED drive: thresholds T_k = ((k - 1/2) / (2^o - 1))^gamma rounded up onto the linear grid, so that x >= T_k on
-  // the grid is exactly x^(1/gamma) (2^o - 1) + 1/2 >= k.
+  // OLED drive: thresholds T_k = ((k - 1/2) / (2^o - 1))^gamma, the light of the drive half a code below k, rounded
+  // up onto the linear grid, so that x >= T_k on the grid is exactly x^(1/gamma) (2^o - 1) + 1/2 >= k.
+  const Panel& panel = config_.decoder.panel;
   for (int ch = 0; ch < 3; ++ch) {
-    const double gamma = config_.decoder.panel.oled.gamma[static_cast<std::size_t>(ch)];
+    const double gamma = panel.channel_gammas()[static_cast<std::size_t>(ch)];
     std::vector<Raw>& t = thresholds_[static_cast<std::size_t>(ch)];
     t.resize(static_cast<std::size_t>(top) + 1);
     t[0] = 0;
     for (int k = 1; k <= top; ++k) {
       t[static_cast<std::size_t>(k)] =
-          static_cast<Raw>(std::ceil(std::ldexp(std::pow((k - 0.5) / top, gamma), F)));
+          static_cast<Raw>(std::ceil(std::ldexp(panel.linear_from_drive((k - 0.5) / top, ch), F)));
     }
     fx::LutShape drive_shape;
     drive_shape.input_bits = drive_address_bits;
@@ -133,11 +135,6 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
     drive_shape.output_frac_bits = config_.drive_frac_bits;
     drive_luts_[static_cast<std::size_t>(ch)] =
         std::make_unique<fx::InterpolatedLut>(fx::make_inverse_gamma_lut(gamma, drive_shape));
-    std::vector<double>& e = emission_[static_cast<std::size_t>(ch)];
-    e.resize(static_cast<std::size_t>(top) + 1);
-    for (int code = 0; code <= top; ++code) {
-      e[static_cast<std::size_t>(code)] = config_.decoder.panel.linear_from_drive(static_cast<double>(code) / top, ch);
-    }
   }
 }
 
@@ -165,11 +162,10 @@ const Geometry& FixedKernels::geometry(cv::Size full) {
   };
   const auto bilinear_axis = [&](int full_n, int reduced_n) {
     std::vector<BilinearWeights> axis(static_cast<std::size_t>(full_n));
-    const double scale = std::ldexp(1.0, config_.bilinear_weight_frac_bits);
+    const fx::RuntimeFormat weight{1, config_.bilinear_weight_frac_bits, false, fx::Quant::Rnd, fx::Overflow::Sat};
     for (int x = 0; x < full_n; ++x) {
       const BilinearTap tap = bilinear_tap(x, full_n, reduced_n);
-      // frac = num / 2W exactly; 2W <= 2^31 and the scale is a power of two, so the rounding is exact.
-      axis[static_cast<std::size_t>(x)] = {tap.i0, tap.i1, static_cast<Raw>(std::floor(tap.frac * scale + 0.5))};
+      axis[static_cast<std::size_t>(x)] = {tap.i0, tap.i1, fx::quantise_double(tap.frac, weight)};
     }
     return axis;
   };

@@ -164,12 +164,6 @@ LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t
   return out;
 }
 
-double FixedKernels::lcd_emitted(std::uint16_t code, std::uint16_t previous_code) const {
-  const LcdPanel& lcd = config_.decoder.panel.lcd;
-  const double top = max_output_code();
-  return std::pow(std::max(lcd.merge(code / top, previous_code / top), 0.0), lcd.gamma);
-}
-
 Raw FixedKernels::luma(const Raw* rgb) const {
   const Raw sum = luma_weights_[0] * rgb[0] + luma_weights_[1] * rgb[1] + luma_weights_[2] * rgb[2];
   return fx::rounded_shift(sum, config_.luma_weight_frac_bits, fx::Quant::Rnd);  // uQ1.F

@@ -144,7 +144,7 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
     store.samples = samples;
     store.bits = bits;
   };
-  const bool lcd = c.decoder.panel.kind == PanelKind::Lcd;
+  const bool lcd = c.decoder.panel.has_history();
   if (lcd) {
     add_frame_store("frame: LCD v_{t-1} (drive codes; re-shown when a view is lost)", g.full.height,
                     3 * g.full.width, c.decoder.output_bits);

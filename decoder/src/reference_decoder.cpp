@@ -228,120 +228,67 @@ struct PanelDrive {
   std::size_t unreachable_count = 0;
 };
 
-// OLED: v = x^(1/gamma_c) per channel; the panel emits (code / (2^out - 1))^gamma_c.
-PanelDrive drive_oled(const cv::Mat& wanted, const Panel& panel, int output_bits) {
-  PanelDrive out;
-  out.drive.create(wanted.size(), CV_64FC3);
-  for (int y = 0; y < wanted.rows; ++y) {
-    const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
-    cv::Vec3d* v_row = out.drive.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < wanted.cols; ++x) {
-      for (int ch = 0; ch < 3; ++ch) v_row[x][ch] = panel.drive_from_linear(x_row[x][ch], ch);
-    }
-  }
-  out.codes = quantise(out.drive, output_bits);
-
-  // The emitted light depends only on the code: one table per channel.
-  const int top = max_code(output_bits);
-  std::array<std::vector<double>, 3> emission;
-  for (int ch = 0; ch < 3; ++ch) {
-    emission[static_cast<std::size_t>(ch)].resize(static_cast<std::size_t>(top) + 1);
-    for (int code = 0; code <= top; ++code) {
-      emission[static_cast<std::size_t>(ch)][static_cast<std::size_t>(code)] =
-          panel.linear_from_drive(static_cast<double>(code) / top, ch);
-    }
-  }
-  out.emitted_linear.create(wanted.size(), CV_64FC3);
-  for (int y = 0; y < wanted.rows; ++y) {
-    const cv::Vec3w* q_row = out.codes.ptr<cv::Vec3w>(y);
-    cv::Vec3d* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < wanted.cols; ++x) {
-      for (int ch = 0; ch < 3; ++ch) e_row[x][ch] = emission[static_cast<std::size_t>(ch)][q_row[x][ch]];
-    }
-  }
-  return out;
-}
-
-// LCD (Eq. 7 inverse, DESIGN §4): the pair (v_{t-1}, v_t) is seen as the merged value M(v_t, v_{t-1}) with
-// luminance M^gamma, the time average of the two frames. To add x_t after a frame that contributed x_{t-1}, the
-// pair must merge to m = ((x_t + x_{t-1}) / 2)^(1/gamma); v_{t-1} is the drive actually shown (quantised), and
-// M(v_t, v_{t-1}) = m is solved for v_t.
+// The panel inverse of every sample through the panel model (DESIGN §4). With history (LCD, Eq. 7): the pair
+// (v_{t-1}, v_t) is seen as the merged value M(v_t, v_{t-1}); to add x_t after a frame that contributed x_{t-1} the
+// pair must merge to m, and v_{t-1} is the drive actually shown (quantised).
 //
-// Unreachable m: v_t is clamped to the closest attainable merge. The pair then averages to M(v_t, v_{t-1})^gamma,
-// so frame t effectively contributed x_t_eff = 2 M(v_t, v_{t-1})^gamma - x_{t-1}. The linear shortfall
-// x_t - x_t_eff is returned so that, for a full frame, it joins rho and the next reduced frame makes it up (paper
-// Sec. 4.4: "add the difference between the desired value and the displayed value to the residual buffer").
-// It uses the unquantised v_t: drive quantisation error is never fed back (DESIGN §3).
+// Unreachable m: the linear shortfall x_t - x_t_eff is returned so that, for a full frame, it joins rho and the next
+// reduced frame makes it up (paper Sec. 4.4: "add the difference between the desired value and the displayed value
+// to the residual buffer"). It uses the unquantised v_t: drive quantisation error is never fed back (DESIGN §3).
 //
-// With LcdHistory::Contributed, x_t_eff rather than x_t is what the next frame's target builds on: the next pair is wanted to average
-// (x_{t+1} + x_t_eff) / 2, and with x_{t+1} = alpha + rho + shortfall that is (alpha + beta) / 2 = I for static
-// content. Building on the wanted x_t instead would count the shortfall twice (it is already in rho), leaving
-// the pair shortfall / 2 too bright. Where m was reachable x_t_eff = x_t, so x_t is kept bit for bit. The design's
-// rule (LcdHistory::Wanted, the default) builds on the wanted x_t, as independent implementations of it do.
-// x_t_eff may leave [0, 1]; the pair average is clamped at 0 before the 1/gamma power, and negative merged
-// values (possible with custom parameters) emit no light.
-PanelDrive drive_lcd(const cv::Mat& wanted, const cv::Mat& previous_wanted, const cv::Mat& previous_drive,
-                     const LcdPanel& lcd, int output_bits) {
+// With LcdHistory::Contributed, x_t_eff rather than x_t is what the next frame's target builds on: the next pair is
+// wanted to average (x_{t+1} + x_t_eff) / 2, and with x_{t+1} = alpha + rho + shortfall that is (alpha + beta) / 2 = I
+// for static content. Building on the wanted x_t instead would count the shortfall twice (it is already in rho),
+// leaving the pair shortfall / 2 too bright. Where m was reachable x_t_eff = x_t, so x_t is kept bit for bit. The
+// design's rule (LcdHistory::Wanted, the default) builds on the wanted x_t, as independent implementations of it do.
+// previous_wanted and previous_drive are read only for a panel with history.
+PanelDrive drive_panel(const cv::Mat& wanted, const cv::Mat& previous_wanted, const cv::Mat& previous_drive,
+                       const Panel& panel, const PanelEmission& emission, int output_bits) {
   PanelDrive out;
   const cv::Size size = wanted.size();
+  const bool history = panel.has_history();
   out.drive.create(size, CV_64FC3);
-  out.shortfall = cv::Mat::zeros(size, CV_64FC3);
-  out.contributed = wanted.clone();
-  out.target.create(size, CV_64FC3);
-  out.unreachable = cv::Mat::zeros(size, CV_8UC3);
-  const double inverse_gamma = 1.0 / lcd.gamma;
-  const auto luminance = [&lcd](double merged) { return std::pow(std::max(merged, 0.0), lcd.gamma); };
+  if (history) {
+    out.shortfall = cv::Mat::zeros(size, CV_64FC3);
+    out.contributed = wanted.clone();
+    out.target.create(size, CV_64FC3);
+    out.unreachable = cv::Mat::zeros(size, CV_8UC3);
+    out.previous_drive = previous_drive;
+  }
   for (int y = 0; y < size.height; ++y) {
     const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
-    const cv::Vec3d* xp_row = previous_wanted.ptr<cv::Vec3d>(y);
-    const cv::Vec3d* vp_row = previous_drive.ptr<cv::Vec3d>(y);
+    const cv::Vec3d* xp_row = history ? previous_wanted.ptr<cv::Vec3d>(y) : nullptr;
+    const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
     cv::Vec3d* v_row = out.drive.ptr<cv::Vec3d>(y);
-    cv::Vec3d* s_row = out.shortfall.ptr<cv::Vec3d>(y);
-    cv::Vec3d* c_row = out.contributed.ptr<cv::Vec3d>(y);
-    cv::Vec3d* m_row = out.target.ptr<cv::Vec3d>(y);
-    cv::Vec3b* u_row = out.unreachable.ptr<cv::Vec3b>(y);
     for (int x = 0; x < size.width; ++x) {
       for (int ch = 0; ch < 3; ++ch) {
         const double x_t = x_row[x][ch];
-        const double x_prev = xp_row[x][ch];
-        const double v_prev = vp_row[x][ch];
-        const double m = std::pow(std::max(0.5 * (x_t + x_prev), 0.0), inverse_gamma);
-        const LcdPanel::Solution solution = lcd.solve(m, v_prev);
-        m_row[x][ch] = m;
-        v_row[x][ch] = solution.v;
-        if (!solution.reachable) {
+        const double x_prev = history ? xp_row[x][ch] : 0.0;
+        const PanelDriveSample sample = panel.drive(x_t, x_prev, history ? vp_row[x][ch] : 0.0, ch);
+        v_row[x][ch] = sample.v;
+        if (!history) continue;
+        out.target.ptr<cv::Vec3d>(y)[x][ch] = sample.target;
+        if (!sample.reachable) {
           ++out.unreachable_count;
-          u_row[x][ch] = 255;
-          const double x_t_effective = 2.0 * luminance(lcd.merge(solution.v, v_prev)) - x_prev;
-          s_row[x][ch] = x_t - x_t_effective;
-          c_row[x][ch] = x_t_effective;
+          out.unreachable.ptr<cv::Vec3b>(y)[x][ch] = 255;
+          out.shortfall.ptr<cv::Vec3d>(y)[x][ch] = x_t - sample.contributed;
+          out.contributed.ptr<cv::Vec3d>(y)[x][ch] = sample.contributed;
         }
       }
     }
   }
   out.codes = quantise(out.drive, output_bits);
-  out.previous_drive = previous_drive;
 
-  // Both drives are codes (v_{t-1} = code / (2^out - 1) exactly), so the emitted M(v_t, v_{t-1})^gamma takes
-  // only (2^out)^2 values: tabulate them instead of a pow per sample (same doubles).
   const int top = max_code(output_bits);
-  const std::size_t codes_per_axis = static_cast<std::size_t>(top) + 1;
-  std::vector<double> emission(codes_per_axis * codes_per_axis);
-  for (std::size_t code = 0; code < codes_per_axis; ++code) {
-    for (std::size_t previous = 0; previous < codes_per_axis; ++previous) {
-      emission[code * codes_per_axis + previous] =
-          luminance(lcd.merge(static_cast<double>(code) / top, static_cast<double>(previous) / top));
-    }
-  }
   out.emitted_linear.create(size, CV_64FC3);
   for (int y = 0; y < size.height; ++y) {
     const cv::Vec3w* q_row = out.codes.ptr<cv::Vec3w>(y);
-    const cv::Vec3d* vp_row = previous_drive.ptr<cv::Vec3d>(y);
+    const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
     cv::Vec3d* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
     for (int x = 0; x < size.width; ++x) {
       for (int ch = 0; ch < 3; ++ch) {
-        const auto previous_code = static_cast<std::size_t>(std::lround(vp_row[x][ch] * top));
-        e_row[x][ch] = emission[q_row[x][ch] * codes_per_axis + previous_code];
+        const auto previous_code = history ? static_cast<std::uint16_t>(std::lround(vp_row[x][ch] * top)) : 0;
+        e_row[x][ch] = emission(q_row[x][ch], previous_code, ch);
       }
     }
   }
@@ -385,7 +332,8 @@ void DecoderConfig::validate() const {
   validate_panel(panel, "DecoderConfig: ");
 }
 
-ReferenceDecoder::ReferenceDecoder(DecoderConfig config) : config_(std::move(config)) { config_.validate(); }
+ReferenceDecoder::ReferenceDecoder(DecoderConfig config)
+    : config_((config.validate(), std::move(config))), emission_(config_.panel, config_.output_bits) {}
 
 DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
   const cv::Size full(meta.full_width, meta.full_height);
@@ -430,7 +378,7 @@ DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame, std::span<const st
 DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) { return decode_view(frame, {}); }
 
 void ReferenceDecoder::adopt_panel_history(const DecodedFrame& shown) {
-  if (config_.panel.kind != PanelKind::Lcd) {
+  if (!config_.panel.has_history()) {
     throw std::invalid_argument("ReferenceDecoder: adopt_panel_history is for LCD panels (an OLED has no history)");
   }
   const auto found = eyes_.find(shown.meta.eye);
@@ -536,15 +484,13 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     }
   }
 
-  PanelDrive drive;
-  if (config_.panel.kind == PanelKind::Oled) {
-    drive = drive_oled(wanted, config_.panel, config_.output_bits);
-  } else {
-    if (eye.previous_drive.empty()) {
-      std::tie(eye.previous_wanted, eye.previous_drive) = held_history(wanted, config_.panel, config_.output_bits);
-    }
-    const cv::Mat previous_linear = eye.previous_wanted;
-    drive = drive_lcd(wanted, previous_linear, eye.previous_drive, config_.panel.lcd, config_.output_bits);
+  if (config_.panel.has_history() && eye.previous_drive.empty()) {
+    std::tie(eye.previous_wanted, eye.previous_drive) = held_history(wanted, config_.panel, config_.output_bits);
+  }
+  const cv::Mat previous_linear = eye.previous_wanted;
+  const PanelDrive drive =
+      drive_panel(wanted, previous_linear, eye.previous_drive, config_.panel, emission_, config_.output_bits);
+  if (config_.panel.has_history()) {
     out.stats.lcd_unreachable_fraction = static_cast<double>(drive.unreachable_count) / samples;
     if (meta.parity == Parity::Full && drive.unreachable_count > 0) add_shortfall(eye.residual, drive.shortfall);
     eye.previous_wanted = config_.lcd_history == LcdHistory::Contributed ? drive.contributed : wanted;
