@@ -83,10 +83,10 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometr
     // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
     const CompensatedSample s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
     if (out.taps != nullptr) {
-      tap(out, FixedStage::Linear, y, x, ch, full_linear);
-      tap(out, FixedStage::LowPass, y, x, ch, low_linear);
-      tap(out, FixedStage::Beta, y, x, ch, s.shown + s.rho);
-      tap(out, FixedStage::Shown, y, x, ch, s.shown);
+      tap(out, Stage::Linear, y, x, ch, full_linear);
+      tap(out, Stage::LowPass, y, x, ch, low_linear);
+      tap(out, Stage::Beta, y, x, ch, s.shown + s.rho);
+      tap(out, Stage::Shown, y, x, ch, s.shown);
     }
     t.clipped += s.clipped ? 1 : 0;
     t.counts.beta_clipped += s.clipped ? 1 : 0;
@@ -94,7 +94,7 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometr
     const Raw shortfall = emit(out, eye, y, x, ch, s.shown);
     const StoredResidual stored = kernels_.store_residual(s.rho + shortfall);
     residual_row[3 * x + ch] = static_cast<std::int32_t>(stored.value);
-    tap(out, FixedStage::Residual, y, x, ch, stored.value);
+    tap(out, Stage::Residual, y, x, ch, stored.value);
     t.counts.residual_saturated += stored.saturated ? 1 : 0;
     t.counts.residual_rounded += stored.rounded ? 1 : 0;
     const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
@@ -123,7 +123,7 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   Raw alpha[3];
   for (int ch = 0; ch < 3; ++ch) {
     alpha[ch] = kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
-    tap(out, FixedStage::Alpha, y, x, ch, alpha[ch]);
+    tap(out, Stage::Alpha, y, x, ch, alpha[ch]);
   }
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
@@ -131,7 +131,7 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
     // No full frame just before: alpha alone (U of codes stays within [0, 1]; the clamp only guards).
     for (int ch = 0; ch < 3; ++ch) {
       const Raw shown = std::clamp(alpha[ch], Raw{0}, kernels_.one());
-      tap(out, FixedStage::AlphaPrime, y, x, ch, shown);
+      tap(out, Stage::AlphaPrime, y, x, ch, shown);
       emit(out, eye, y, x, ch, shown);
     }
     return;
@@ -149,9 +149,9 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   const Raw weight = motion_static ? kernels_.one()  // c = 0: w = 1 exactly (DESIGN §4)
                                    : kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);
   if (out.taps != nullptr) {
-    for (int ch = 0; ch < 3; ++ch) tap(out, FixedStage::PreviousLowPass, y, x, ch, previous[ch]);
-    tap(out, FixedStage::Contrast, y, x, 0, kernels_.motion_contrast(kernels_.luma(previous), kernels_.luma(alpha)));
-    tap(out, FixedStage::Weight, y, x, 0, weight);
+    for (int ch = 0; ch < 3; ++ch) tap(out, Stage::PreviousLowPass, y, x, ch, previous[ch]);
+    tap(out, Stage::Contrast, y, x, 0, kernels_.motion_contrast(kernels_.luma(previous), kernels_.luma(alpha)));
+    tap(out, Stage::Weight, y, x, 0, weight);
   }
   t.weight_sum += weight;
   t.counts.weight_underflow += underflow ? 1 : 0;
@@ -165,7 +165,7 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
     const Raw magnitude = residual < 0 ? -residual : residual;
     t.residual_abs_sum += magnitude;
     t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
-    tap(out, FixedStage::AlphaPrime, y, x, ch, s.alpha_prime);
+    tap(out, Stage::AlphaPrime, y, x, ch, s.alpha_prime);
     emit(out, eye, y, x, ch, s.alpha_prime);
   }
 }
@@ -177,11 +177,11 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
   const int b = c.decoder.link.bits;
   const std::string linear = "uQ1." + std::to_string(F);
   taps = FixedStageTaps();
-  const auto add = [&](FixedStage stage, const char* name, const std::string& format, int bits, bool is_signed,
+  const auto add = [&](Stage stage, const std::string& format, int bits, bool is_signed,
                        cv::Size size, int channels) {
     FixedStagePlane& p = taps[stage];
     p.present = true;
-    p.name = name;
+    p.name = stage_name(stage);
     p.format = format;
     p.bits = bits;
     p.is_signed = is_signed;
@@ -190,27 +190,26 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
     p.values.assign(static_cast<std::size_t>(size.width) * static_cast<std::size_t>(size.height) * static_cast<std::size_t>(channels), 0);
   };
   const std::string code = "uQ" + std::to_string(b) + ".0";
-  add(FixedStage::Codes, "codes", code, b, false, full ? g.full : g.reduced, 3);
+  add(Stage::Codes, code, b, false, full ? g.full : g.reduced, 3);
   if (full) {
-    add(FixedStage::Linear, "I", linear, 1 + F, false, g.full, 3);
-    add(FixedStage::Reduced, "d", code, b, false, g.reduced, 3);
-    add(FixedStage::LowPass, "L", linear, 1 + F, false, g.full, 3);
-    add(FixedStage::Beta, "beta", "sQ3." + std::to_string(F), 3 + F, true, g.full, 3);
-    add(FixedStage::Shown, "shown", linear, 1 + F, false, g.full, 3);
-    add(FixedStage::Residual, "rho",
-        std::string("sQ") + std::to_string(c.residual.int_bits) + "." + std::to_string(c.residual.frac_bits),
+    add(Stage::Linear, linear, 1 + F, false, g.full, 3);
+    add(Stage::Reduced, code, b, false, g.reduced, 3);
+    add(Stage::LowPass, linear, 1 + F, false, g.full, 3);
+    add(Stage::Beta, "sQ3." + std::to_string(F), 3 + F, true, g.full, 3);
+    add(Stage::Shown, linear, 1 + F, false, g.full, 3);
+    add(Stage::Residual, std::string("sQ") + std::to_string(c.residual.int_bits) + "." + std::to_string(c.residual.frac_bits),
         c.residual.width(), true, g.full, 3);
   } else {
-    add(FixedStage::Alpha, "alpha", linear, 1 + F, false, g.full, 3);
+    add(Stage::Alpha, linear, 1 + F, false, g.full, 3);
     if (residual) {
-      add(FixedStage::PreviousLowPass, "L_prev", linear, 1 + F, false, g.full, 3);
-      add(FixedStage::Contrast, "c", linear, 1 + F, false, g.full, 1);
-      add(FixedStage::Weight, "w", linear, 1 + F, false, g.full, 1);
+      add(Stage::PreviousLowPass, linear, 1 + F, false, g.full, 3);
+      add(Stage::Contrast, linear, 1 + F, false, g.full, 1);
+      add(Stage::Weight, linear, 1 + F, false, g.full, 1);
     }
-    add(FixedStage::AlphaPrime, "alpha_prime", linear, 1 + F, false, g.full, 3);
+    add(Stage::AlphaPrime, linear, 1 + F, false, g.full, 3);
   }
   const int o = c.decoder.output_bits;
-  add(FixedStage::Drive, "drive", "uQ" + std::to_string(o) + ".0", o, false, g.full, 3);
+  add(Stage::Drive, "uQ" + std::to_string(o) + ".0", o, false, g.full, 3);
   out.taps = &taps;
 }
 

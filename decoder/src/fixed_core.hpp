@@ -115,7 +115,7 @@ class FixedDecoderCore {
   // Test vectors: marks the stages of this frame kind present in taps, sized and formatted, and attaches them.
   void start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full, bool residual) const;
   // Records one value of a stage plane (no-op without taps).
-  static void tap(FrameOutput& out, FixedStage stage, int y, int x, int ch, Raw value) {
+  static void tap(FrameOutput& out, Stage stage, int y, int x, int ch, Raw value) {
     if (out.taps == nullptr) return;
     FixedStagePlane& p = (*out.taps)[stage];
     p.values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(p.size.width) + static_cast<std::size_t>(x)) *

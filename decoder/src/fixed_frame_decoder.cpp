@@ -89,8 +89,8 @@ DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, FixedStageTaps& t
       std::copy(row, row + 3 * m.cols, p.values.begin() + static_cast<std::ptrdiff_t>(y) * 3 * m.cols);
     }
   };
-  copy_codes(frame.codes, taps[FixedStage::Codes]);
-  copy_codes(decoded.drive_codes, taps[FixedStage::Drive]);
+  copy_codes(frame.codes, taps[Stage::Codes]);
+  copy_codes(decoded.drive_codes, taps[Stage::Drive]);
   return decoded;
 }
 
@@ -114,7 +114,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
   if (frame.meta.parity == Parity::Full) {
     const cv::Mat low = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t codes
     if (taps != nullptr) {
-      std::vector<std::int64_t>& d = (*taps)[FixedStage::Reduced].values;
+      std::vector<std::int64_t>& d = (*taps)[Stage::Reduced].values;
       for (int k = 0; k < low.rows; ++k) {
         const std::uint16_t* in = low.ptr<std::uint16_t>(k);
         std::copy(in, in + 3 * low.cols, d.begin() + static_cast<std::ptrdiff_t>(k) * 3 * low.cols);

@@ -438,10 +438,12 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     eye.residual = residual;
     eye.previous_low = low_codes;
     if (config_.record_stages) {
-      stages.low_codes = low_codes;
-      stages.low_linear = low_linear;
-      stages.full_linear = full_linear;
-      stages.beta = beta;
+      stages.at(Stage::Codes) = frame.codes;
+      stages.at(Stage::Reduced) = low_codes;
+      stages.at(Stage::LowPass) = low_linear;
+      stages.at(Stage::Linear) = full_linear;
+      stages.at(Stage::Beta) = beta;
+      stages.at(Stage::Shown) = wanted;
     }
   } else {
     const cv::Mat alpha = upsampled_linear(frame.codes, full, link);  // Eq. 1
@@ -463,11 +465,11 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
       out.stats.residual_mean_abs = consumed.mean_abs;
       out.stats.residual_max_abs = consumed.max_abs;
       if (config_.record_stages) {
-        stages.residual = eye.residual;
-        stages.previous_low_linear = previous_low_linear;
-        stages.contrast = contrast;
-        stages.weight = weight;
-        stages.alpha_unclamped = added.alpha_unclamped;
+        stages.at(Stage::Residual) = eye.residual;
+        stages.at(Stage::PreviousLowPass) = previous_low_linear;
+        stages.at(Stage::Contrast) = contrast;
+        stages.at(Stage::Weight) = weight;
+        stages.at(Stage::AlphaUnclamped) = added.alpha_unclamped;
       }
     } else {
       // No full frame just before this one (stream start, lost frame, two reduced in a row): alpha alone.
@@ -479,8 +481,9 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     eye.residual.release();
     eye.previous_low.release();
     if (config_.record_stages) {
-      stages.low_codes = frame.codes;
-      stages.low_linear = alpha;
+      stages.at(Stage::Codes) = frame.codes;
+      stages.at(Stage::Alpha) = alpha;
+      stages.at(Stage::AlphaPrime) = wanted;
     }
   }
 
@@ -496,10 +499,10 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     eye.previous_wanted = config_.lcd_history == LcdHistory::Contributed ? drive.contributed : wanted;
     eye.previous_drive = dequantise(drive.codes, config_.output_bits);
     if (config_.record_stages) {
-      stages.lcd_target = drive.target;
-      stages.lcd_previous_drive = drive.previous_drive;
-      stages.lcd_previous_linear = previous_linear;
-      stages.lcd_unreachable = drive.unreachable;
+      stages.at(Stage::LcdTarget) = drive.target;
+      stages.at(Stage::LcdPreviousDrive) = drive.previous_drive;
+      stages.at(Stage::LcdPreviousLinear) = previous_linear;
+      stages.at(Stage::LcdUnreachable) = drive.unreachable;
     }
   }
 
@@ -507,7 +510,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     const ResidualSummary kept = summarise_residual(eye.residual);
     out.stats.residual_mean_abs = kept.mean_abs;
     out.stats.residual_max_abs = kept.max_abs;
-    if (config_.record_stages) stages.residual = eye.residual.clone();
+    if (config_.record_stages) stages.at(Stage::Residual) = eye.residual.clone();
   }
 
   out.wanted_linear = wanted;
@@ -515,7 +518,10 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   out.drive_codes = drive.codes;
   out.emitted_linear = drive.emitted_linear;
   eye.last_output = out;
-  if (config_.record_stages) out.stages = std::move(stages);
+  if (config_.record_stages) {
+    stages.at(Stage::Drive) = drive.codes;
+    out.stages = std::move(stages);
+  }
   return out;
 }
 
