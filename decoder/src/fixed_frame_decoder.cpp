@@ -1,6 +1,6 @@
 // Frame-at-a-time schedule of the fixed-point decoder: each stage runs over a whole frame before the next, as in
 // the reference decoder, calling the shared per-pixel arithmetic (fixed_kernels.hpp).
-#include "fixed_kernels.hpp"
+#include "fixed_core.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -44,7 +44,7 @@ cv::Mat reduce_whole_frame(const fixed_detail::FixedKernels& kernels, const Geom
 // the stored d_{t-1} row k. Rows above the first intact line of a view without a d_{t-1} substitute are not compared
 // (the streaming schedule never holds them), so they never skip.
 std::vector<std::uint8_t> compare_lines(const cv::Mat& codes, const cv::Mat& previous_low,
-                                        const fixed_detail::Concealment* lost) {
+                                        const detail::Concealment* lost) {
   const int first = lost != nullptr && lost->substitute.empty() ? lost->first_intact : 0;
   std::vector<std::uint8_t> flags(static_cast<std::size_t>(codes.rows), 0);
   for (int k = first; k < codes.rows; ++k) {
@@ -67,11 +67,11 @@ const FixedStageCounts& FixedFrameDecoder::last_counts() const { return core_->l
 DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame) { return decode_impl(frame, nullptr, nullptr); }
 
 DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  fixed_detail::Concealment lost;
+  detail::Concealment lost;
   switch (core_->classify(frame, line_intact, lost, "FixedFrameDecoder")) {
-    case FixedDecoderCore::Arrival::Whole: return decode_impl(frame, nullptr, nullptr);
-    case FixedDecoderCore::Arrival::Lost: return core_->decode_lost(frame.meta, "FixedFrameDecoder");
-    case FixedDecoderCore::Arrival::Partial: break;
+    case detail::Arrival::Whole: return decode_impl(frame, nullptr, nullptr);
+    case detail::Arrival::Lost: return core_->decode_lost(frame.meta, "FixedFrameDecoder");
+    case detail::Arrival::Partial: break;
   }
   return decode_impl(frame, nullptr, &lost);
 }
@@ -89,16 +89,16 @@ DecodedFrame FixedFrameDecoder::decode(const LinkFrame& frame, FixedStageTaps& t
       std::copy(row, row + 3 * m.cols, p.values.begin() + static_cast<std::ptrdiff_t>(y) * 3 * m.cols);
     }
   };
-  copy_codes(frame.codes, taps[FixedStage::Codes]);
-  copy_codes(decoded.drive_codes, taps[FixedStage::Drive]);
+  copy_codes(frame.codes, taps[Stage::Codes]);
+  copy_codes(decoded.drive_codes, taps[Stage::Drive]);
   return decoded;
 }
 
 DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStageTaps* taps,
-                                            const fixed_detail::Concealment* lost) {
+                                            const detail::Concealment* lost) {
   fixed_detail::EyeState& eye = core_->begin(received, "FixedFrameDecoder");
   // Concealment: every lost line replaced first, then the view decoded as if it had arrived so.
-  const LinkFrame frame = lost != nullptr ? LinkFrame{received.meta, FixedDecoderCore::concealed_codes(received.codes, *lost)}
+  const LinkFrame frame = lost != nullptr ? LinkFrame{received.meta, detail::concealed_codes(received.codes, *lost)}
                                           : received;
   const Geometry& g = core_->kernels().geometry(eye.full_size);
   fixed_detail::FrameOutput out = core_->start_output(frame);
@@ -114,7 +114,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
   if (frame.meta.parity == Parity::Full) {
     const cv::Mat low = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t codes
     if (taps != nullptr) {
-      std::vector<std::int64_t>& d = (*taps)[FixedStage::Reduced].values;
+      std::vector<std::int64_t>& d = (*taps)[Stage::Reduced].values;
       for (int k = 0; k < low.rows; ++k) {
         const std::uint16_t* in = low.ptr<std::uint16_t>(k);
         std::copy(in, in + 3 * low.cols, d.begin() + static_cast<std::ptrdiff_t>(k) * 3 * low.cols);

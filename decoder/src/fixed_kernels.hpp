@@ -1,5 +1,6 @@
 // The per-pixel arithmetic of the fixed-point decoder, one function per stage, shared by the frame-at-a-time and
-// the streaming schedules (so they can differ only in scheduling), plus the state both keep per eye.
+// the streaming schedules (so they can differ only in scheduling). What the schedules keep per eye and per frame is
+// in fixed_core.hpp.
 // Raw values are integers; each function states its Q formats. F = linear_frac_bits throughout.
 #pragma once
 
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -17,18 +19,6 @@
 namespace trm::fixed_detail {
 
 using Raw = std::int64_t;
-
-// Round half up (SC_RND) of v / 2^shift; C++20 >> on negative values is arithmetic, so this holds for any sign.
-inline Raw round_shift(Raw v, int shift) { return shift <= 0 ? v * (Raw{1} << -shift) : (v + (Raw{1} << (shift - 1))) >> shift; }
-
-// Round half to even (SC_RND_CONV) of v / 2^shift, shift >= 1. Used where two values that sum to an integer must
-// still do so after rounding (complementary rows of a Nyquist pattern in the D line buffer).
-inline Raw round_convergent_shift(Raw v, int shift) {
-  const Raw floor = v >> shift;
-  const Raw rest = v - (floor << shift);
-  const Raw half = Raw{1} << (shift - 1);
-  return floor + ((rest > half || (rest == half && (floor & 1) != 0)) ? 1 : 0);
-}
 
 // D taps of one reduced sample along one axis: indices clamped (replicate), weights uQ0.T summing to 2^T.
 struct PolyphaseTaps {
@@ -85,16 +75,6 @@ struct WeightedSample {
   bool clipped = false;
 };
 
-// Order-independent accumulators of one frame (integers, so both schedules report identical statistics).
-struct FrameTally {
-  FixedStageCounts counts;
-  std::uint64_t clipped = 0;     // samples for FrameStats::clipped_fraction
-  Raw dropped_sum = 0;           // uQ.F
-  Raw weight_sum = 0;            // uQ.F over pixels
-  Raw residual_abs_sum = 0;      // in residual format LSBs
-  Raw residual_abs_max = 0;
-};
-
 class FixedKernels {
  public:
   explicit FixedKernels(const FixedDecoderConfig& config);
@@ -144,7 +124,6 @@ class FixedKernels {
   // LCD (Eq. 7 inverse): the drive code whose merge with v_{t-1} = previous_code reaches m = ((x_t + x_{t-1})/2)^(1/g).
   // held: the eye's first frame, x_{t-1} = x_t and the pixel held (M(v, v)); returns the held code.
   LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const;
-  double lcd_emitted(std::uint16_t code, std::uint16_t previous_code) const;
 
   // Rec. 709 luma of linear RGB (uQ1.F each); uQ1.F.
   Raw luma(const Raw* rgb) const;
@@ -167,11 +146,14 @@ class FixedKernels {
   std::uint16_t drive_code(Raw linear, int ch) const;
   // Drive value v = x^(1/gamma) for reports, uQ1.drive_frac_bits.
   Raw drive_value(Raw linear, int ch) const;
-  double emitted_of_code(std::uint16_t code, int ch) const { return emission_[ch][code]; }
+  // The light drive code `code` emits after `previous_code` (read only for a panel with history).
+  double emitted(std::uint16_t code, std::uint16_t previous_code, int ch) const {
+    return (*emission_)(code, previous_code, ch);
+  }
 
   // Every ROM of this configuration (name, words, word bits, copies).
   std::vector<FixedRomReport> roms() const;
-  // The operator table of the per-pixel stages at the geometry's sizes (see the table in fixed_kernels.cpp).
+  // The operator table of the per-pixel stages at the geometry's sizes (see the table in fixed_resources.cpp).
   std::vector<FixedArithmeticReport> arithmetic(const Geometry& g) const;
 
   // Exact conversions (the raw values have at most 53 significant bits; the scales are powers of two).
@@ -196,7 +178,7 @@ class FixedKernels {
   std::array<std::vector<Raw>, 3> thresholds_;  // T_k, k = 0..2^o - 1 (T_0 = 0)
   std::array<std::unique_ptr<fx::InterpolatedLut>, 3> drive_luts_;
   int drive_lut_shift_ = 0;  // linear LSBs dropped to address the drive LUT (24 address bits at most)
-  std::array<std::vector<double>, 3> emission_;
+  std::optional<PanelEmission> emission_;  // built once the configuration is valid
   double linear_lsb_ = 0.0;
   double drive_lsb_ = 0.0;
   double residual_lsb_ = 0.0;
@@ -213,128 +195,6 @@ class FixedKernels {
   // c = difference / sum through the reciprocal LUT, clamped to 1; difference > 0.
   Raw contrast_of(Raw difference, Raw sum) const;
   Raw lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const;
-};
-
-// What persists between frames of one eye (DESIGN §5 frame stores).
-struct EyeState {
-  cv::Size full_size;
-  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} codes, full size, CV_16UC3 (empty: no history yet)
-  cv::Mat lcd_previous_linear;  // LCD: x_{t-1}, full size, CV_32SC3 sQ.F
-  bool have_residual = false;
-  std::int64_t residual_index = 0;
-  cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
-  cv::Mat previous_low;   // d_t codes, reduced size, CV_16UC3
-  std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
-  DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
-                             // view is lost
-};
-
-// A view that arrived with some lines lost (at least one lost, at least one intact), as the reference conceals it:
-// lost lines of a full frame feed D as copies of the nearest intact line above (else below) and show L_t with
-// rho = 0; lost lines of a reduced frame repeat the row of the stored d_{t-1} (substitute) or, without one, the
-// nearest intact line above (else below).
-struct Concealment {
-  std::span<const std::uint8_t> intact;  // one entry per line of the view; 0 = lost
-  int first_intact = 0;  // lost lines above it have no intact line above: they take this line's content
-  int lost_lines = 0;
-  cv::Mat substitute;    // reduced frames: the eye's d_{t-1} frame store (codes); empty: none
-  bool lost(int y) const { return intact[static_cast<std::size_t>(y)] == 0; }
-};
-
-// The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
-// flags of its U source rows and the full frame's residual line flag.
-struct ReducedLineGate {
-  bool motion_static = false;  // L_{t-1} = alpha on the whole line: w = 1, no motion test
-  bool residual_zero = false;  // rho all zero on the line: no residual read, no add
-};
-
-// Output frame under construction and the per-pixel emission shared by both schedules.
-struct FrameOutput {
-  DecodedFrame frame;
-  FrameTally tally;
-  bool lcd_held = false;  // LCD: the eye's first frame (no v_{t-1} yet)
-  bool full = false;
-  int concealed_lines = 0;
-  FixedStageTaps* taps = nullptr;  // test vectors: stage planes to fill (frame-at-a-time schedule only)
-};
-
-// The state and plumbing shared by both schedules: configuration, ROMs, eye states, input checks and output.
-class FixedDecoderCore {
- public:
-  explicit FixedDecoderCore(FixedDecoderConfig config);
-
-  FixedKernels& kernels() { return kernels_; }
-  const FixedDecoderConfig& config() const { return kernels_.config(); }
-  const FixedStageCounts& last_counts() const { return last_counts_; }
-
-  // Checks the frame and returns the eye state (reset on a change of view size).
-  EyeState& begin(const LinkFrame& frame, const char* who);
-  // Classifies a line mask as the reference does: Whole (empty or every line intact: decode normally), Lost (no
-  // line intact: decode_lost) or Partial, for which `out` is filled. The substitute d_{t-1} is taken when the eye
-  // holds a residual and a d_t of the view's reduced size, looked up before begin() (as the reference does).
-  enum class Arrival { Whole, Partial, Lost };
-  Arrival classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact, Concealment& out,
-                   const char* who);
-  // The codes of a partially received view with every lost line replaced (the frame-at-a-time schedule's form).
-  static cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c);
-  // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
-  DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
-  // Allocates the output matrices at full size.
-  FrameOutput start_output(const LinkFrame& frame) const;
-  // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
-  Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
-  // Prepares the LCD frame stores of the eye for this frame (first frame: held history).
-  void begin_lcd(FrameOutput& out, EyeState& eye) const;
-  // One full-frame pixel, all channels (Eq. 2): U of the d_t rows i0/i1 of output row y, L, I from the codes row,
-  // beta, shown (emitted), rho into residual_row. A lost (concealed) line takes beta = L.
-  void full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* codes_row,
-                  const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row,
-                  bool lost = false) const;
-  // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
-  // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
-  // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are not read);
-  // residual_zero reads no residual (residual_row may then be null) and adds nothing.
-  void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
-                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                     const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr) const;
-  // DESIGN §7 skips (no-ops unless config().skip_unneeded):
-  // after full-frame output line y: flags the line of the residual store whose rho is not all zero (the write
-  // gate), counting the lines not written;
-  void end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const;
-  bool skipping() const { return config().skip_unneeded; }
-  // the gate of reduced-frame output line y from the comparator flags of its source rows (row_flags(k) gives row k's
-  // FixedKernels::compare_line result), counting the skip events.
-  template <typename RowFlags>
-  ReducedLineGate reduced_line_gate(FrameOutput& out, const EyeState& eye, const Geometry& g, int y,
-                                    RowFlags row_flags) const {
-    const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
-    const std::uint8_t f0 = row_flags(row.i0);
-    // With a lower-row weight of 0, U reads the upper row alone (bilinear blend, exactly).
-    const std::uint8_t f1 = row.upper == 0 ? static_cast<std::uint8_t>(FixedKernels::kLineStatic) : row_flags(row.i1);
-    ReducedLineGate gate;
-    gate.motion_static = (f0 & f1 & FixedKernels::kLineStatic) != 0;
-    gate.residual_zero = eye.residual_nonzero.size() == static_cast<std::size_t>(g.full.height) &&
-                         eye.residual_nonzero[static_cast<std::size_t>(y)] == 0;
-    out.tally.counts.motion_test_lines_skipped += gate.motion_static ? 1 : 0;
-    out.tally.counts.residual_read_lines_skipped += gate.residual_zero ? 1 : 0;
-    return gate;
-  }
-  // Test vectors: marks the stages of this frame kind present in taps, sized and formatted, and attaches them.
-  void start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full, bool residual) const;
-  // Records one value of a stage plane (no-op without taps).
-  static void tap(FrameOutput& out, FixedStage stage, int y, int x, int ch, Raw value) {
-    if (out.taps == nullptr) return;
-    FixedStagePlane& p = (*out.taps)[stage];
-    p.values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(p.size.width) + static_cast<std::size_t>(x)) *
-                 static_cast<std::size_t>(p.channels) + static_cast<std::size_t>(ch)] = value;
-  }
-  // Fills FrameStats from the tally, remembers the counts and the eye's output.
-  DecodedFrame finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied);
-
- private:
-  FixedKernels kernels_;
-  std::map<int, EyeState> eyes_;
-  FixedStageCounts last_counts_;
 };
 
 }  // namespace trm::fixed_detail

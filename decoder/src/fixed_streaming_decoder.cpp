@@ -9,10 +9,10 @@
 //      is produced if all its vertical taps have arrived (it enters the 2-line U buffer and the d_t frame store).
 // Reduced frame, after each input line i(k): it enters the 2-line U buffer and every output row with i1 <= k is
 // produced. The residual and d_{t-1} frame stores are read row by row.
-#include "fixed_kernels.hpp"
+#include "fixed_core.hpp"
+#include "line_ring.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,38 +20,11 @@
 namespace trm {
 
 using fixed_detail::FixedDecoderCore;
+using fixed_detail::LineRing;
 using fixed_detail::Geometry;
 using fixed_detail::Raw;
 
 namespace {
-
-// `depth` circular lines of `samples` values; input line n lives in slot n mod depth. Reading a line that was
-// overwritten (or never written) is a scheduling bug and throws.
-template <typename T>
-class LineRing {
- public:
-  LineRing(std::string name, int depth, int samples)
-      : name_(std::move(name)), samples_(samples), data_(static_cast<std::size_t>(depth) * samples), tags_(static_cast<std::size_t>(depth), -1) {}
-
-  T* write(int line) {
-    const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
-    tags_[slot] = line;
-    return data_.data() + slot * static_cast<std::size_t>(samples_);
-  }
-  const T* read(int line) const {
-    const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
-    if (tags_[slot] != line) {
-      throw std::logic_error("line buffer '" + name_ + "': line " + std::to_string(line) + " is not held");
-    }
-    return data_.data() + slot * static_cast<std::size_t>(samples_);
-  }
-
- private:
-  std::string name_;
-  int samples_;
-  std::vector<T> data_;
-  std::vector<int> tags_;
-};
 
 // The full-frame schedule as callbacks: on_input(y_in), on_reduced(k, y_in), on_output(y, y_in, reduced_ready).
 // Nothing is produced before input line `first` (concealment: lost lines above the first intact line take that
@@ -171,7 +144,7 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
     store.samples = samples;
     store.bits = bits;
   };
-  const bool lcd = c.decoder.panel.kind == PanelKind::Lcd;
+  const bool lcd = c.decoder.panel.has_history();
   if (lcd) {
     add_frame_store("frame: LCD v_{t-1} (drive codes; re-shown when a view is lost)", g.full.height,
                     3 * g.full.width, c.decoder.output_bits);
@@ -215,11 +188,11 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
 DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame) { return decode_impl(frame, nullptr); }
 
 DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  fixed_detail::Concealment lost;
+  detail::Concealment lost;
   switch (core_->classify(frame, line_intact, lost, "FixedStreamingDecoder")) {
-    case FixedDecoderCore::Arrival::Whole: return decode_impl(frame, nullptr);
-    case FixedDecoderCore::Arrival::Lost: return core_->decode_lost(frame.meta, "FixedStreamingDecoder");
-    case FixedDecoderCore::Arrival::Partial: break;
+    case detail::Arrival::Whole: return decode_impl(frame, nullptr);
+    case detail::Arrival::Lost: return core_->decode_lost(frame.meta, "FixedStreamingDecoder");
+    case detail::Arrival::Partial: break;
   }
   return decode_impl(frame, &lost);
 }
@@ -250,7 +223,7 @@ void repeat_line(LineRing<T>& ring, int line, int samples) {
 //     view's output starts up to first_intact lines later than normal.
 //   * a lost line of a reduced frame with a stored d_{t-1} takes that frame store's row (an extra row read).
 // Lost lines of a full frame then show L_t (full_pixel), as in the frame-at-a-time schedule.
-DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const fixed_detail::Concealment* lost) {
+DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const detail::Concealment* lost) {
   fixed_detail::EyeState& eye = core_->begin(frame, "FixedStreamingDecoder");
   fixed_detail::FixedKernels& kernels = core_->kernels();
   const Geometry& g = kernels.geometry(eye.full_size);

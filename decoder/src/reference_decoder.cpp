@@ -10,6 +10,7 @@
 #include "trm/reference_decoder.hpp"
 
 #include "lost_view.hpp"
+#include "view_arrival.hpp"
 
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
@@ -34,54 +35,6 @@ constexpr double kLumaG = 0.7152;
 constexpr double kLumaB = 0.0722;
 
 int max_code(int bits) { return (1 << bits) - 1; }
-
-std::string frame_name(const FrameMeta& meta) {
-  return std::string(to_string(meta.parity)) + " frame t=" + std::to_string(meta.index) +
-         " eye=" + std::to_string(meta.eye);
-}
-
-// ---------------------------------------------------------------------------------------------------------
-// Input checks: everything the stages below rely on.
-
-void check_link_frame(const LinkFrame& frame, const DecoderConfig& config) {
-  const FrameMeta& meta = frame.meta;
-  const std::string what = "ReferenceDecoder: " + frame_name(meta) + ": ";
-  check_view_meta(meta, what);
-  if (meta.bits != config.link.bits) {
-    throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
-                                std::to_string(config.link.bits));
-  }
-  if (meta.transfer != config.link.transfer) {
-    throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
-                                to_string(config.link.transfer));
-  }
-  if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
-    throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
-  }
-  if (frame.codes.cols != meta.width || frame.codes.rows != meta.height) {
-    throw std::invalid_argument(what + "codes are " + std::to_string(frame.codes.cols) + "x" +
-                                std::to_string(frame.codes.rows) + " but the metadata says " +
-                                std::to_string(meta.width) + "x" + std::to_string(meta.height));
-  }
-  const cv::Size full(meta.full_width, meta.full_height);
-  const cv::Size expected = meta.parity == Parity::Full
-                                ? full
-                                : cv::Size(reduced_size(full.width, config.link.reduction),
-                                           reduced_size(full.height, config.link.reduction));
-  if (frame.codes.size() != expected) {
-    throw std::invalid_argument(what + "codes are " + std::to_string(frame.codes.cols) + "x" +
-                                std::to_string(frame.codes.rows) + " but a " + to_string(meta.parity) +
-                                " frame of a " + std::to_string(full.width) + "x" + std::to_string(full.height) +
-                                " view at r=" + std::to_string(config.link.reduction) + " must be " +
-                                std::to_string(expected.width) + "x" + std::to_string(expected.height));
-  }
-  double highest = 0.0;
-  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
-  if (highest > max_code(config.link.bits)) {
-    throw std::invalid_argument(what + "code " + std::to_string(static_cast<int>(highest)) + " exceeds the " +
-                                std::to_string(config.link.bits) + "-bit range");
-  }
-}
 
 // ---------------------------------------------------------------------------------------------------------
 // Stages shared by both parities.
@@ -275,120 +228,67 @@ struct PanelDrive {
   std::size_t unreachable_count = 0;
 };
 
-// OLED: v = x^(1/gamma_c) per channel; the panel emits (code / (2^out - 1))^gamma_c.
-PanelDrive drive_oled(const cv::Mat& wanted, const Panel& panel, int output_bits) {
-  PanelDrive out;
-  out.drive.create(wanted.size(), CV_64FC3);
-  for (int y = 0; y < wanted.rows; ++y) {
-    const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
-    cv::Vec3d* v_row = out.drive.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < wanted.cols; ++x) {
-      for (int ch = 0; ch < 3; ++ch) v_row[x][ch] = panel.drive_from_linear(x_row[x][ch], ch);
-    }
-  }
-  out.codes = quantise(out.drive, output_bits);
-
-  // The emitted light depends only on the code: one table per channel.
-  const int top = max_code(output_bits);
-  std::array<std::vector<double>, 3> emission;
-  for (int ch = 0; ch < 3; ++ch) {
-    emission[static_cast<std::size_t>(ch)].resize(static_cast<std::size_t>(top) + 1);
-    for (int code = 0; code <= top; ++code) {
-      emission[static_cast<std::size_t>(ch)][static_cast<std::size_t>(code)] =
-          panel.linear_from_drive(static_cast<double>(code) / top, ch);
-    }
-  }
-  out.emitted_linear.create(wanted.size(), CV_64FC3);
-  for (int y = 0; y < wanted.rows; ++y) {
-    const cv::Vec3w* q_row = out.codes.ptr<cv::Vec3w>(y);
-    cv::Vec3d* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < wanted.cols; ++x) {
-      for (int ch = 0; ch < 3; ++ch) e_row[x][ch] = emission[static_cast<std::size_t>(ch)][q_row[x][ch]];
-    }
-  }
-  return out;
-}
-
-// LCD (Eq. 7 inverse, DESIGN §4): the pair (v_{t-1}, v_t) is seen as the merged value M(v_t, v_{t-1}) with
-// luminance M^gamma, the time average of the two frames. To add x_t after a frame that contributed x_{t-1}, the
-// pair must merge to m = ((x_t + x_{t-1}) / 2)^(1/gamma); v_{t-1} is the drive actually shown (quantised), and
-// M(v_t, v_{t-1}) = m is solved for v_t.
+// The panel inverse of every sample through the panel model (DESIGN §4). With history (LCD, Eq. 7): the pair
+// (v_{t-1}, v_t) is seen as the merged value M(v_t, v_{t-1}); to add x_t after a frame that contributed x_{t-1} the
+// pair must merge to m, and v_{t-1} is the drive actually shown (quantised).
 //
-// Unreachable m: v_t is clamped to the closest attainable merge. The pair then averages to M(v_t, v_{t-1})^gamma,
-// so frame t effectively contributed x_t_eff = 2 M(v_t, v_{t-1})^gamma - x_{t-1}. The linear shortfall
-// x_t - x_t_eff is returned so that, for a full frame, it joins rho and the next reduced frame makes it up (paper
-// Sec. 4.4: "add the difference between the desired value and the displayed value to the residual buffer").
-// It uses the unquantised v_t: drive quantisation error is never fed back (DESIGN §3).
+// Unreachable m: the linear shortfall x_t - x_t_eff is returned so that, for a full frame, it joins rho and the next
+// reduced frame makes it up (paper Sec. 4.4: "add the difference between the desired value and the displayed value
+// to the residual buffer"). It uses the unquantised v_t: drive quantisation error is never fed back (DESIGN §3).
 //
-// With LcdHistory::Contributed, x_t_eff rather than x_t is what the next frame's target builds on: the next pair is wanted to average
-// (x_{t+1} + x_t_eff) / 2, and with x_{t+1} = alpha + rho + shortfall that is (alpha + beta) / 2 = I for static
-// content. Building on the wanted x_t instead would count the shortfall twice (it is already in rho), leaving
-// the pair shortfall / 2 too bright. Where m was reachable x_t_eff = x_t, so x_t is kept bit for bit. The design's
-// rule (LcdHistory::Wanted, the default) builds on the wanted x_t, as independent implementations of it do.
-// x_t_eff may leave [0, 1]; the pair average is clamped at 0 before the 1/gamma power, and negative merged
-// values (possible with custom parameters) emit no light.
-PanelDrive drive_lcd(const cv::Mat& wanted, const cv::Mat& previous_wanted, const cv::Mat& previous_drive,
-                     const LcdPanel& lcd, int output_bits) {
+// With LcdHistory::Contributed, x_t_eff rather than x_t is what the next frame's target builds on: the next pair is
+// wanted to average (x_{t+1} + x_t_eff) / 2, and with x_{t+1} = alpha + rho + shortfall that is (alpha + beta) / 2 = I
+// for static content. Building on the wanted x_t instead would count the shortfall twice (it is already in rho),
+// leaving the pair shortfall / 2 too bright. Where m was reachable x_t_eff = x_t, so x_t is kept bit for bit. The
+// design's rule (LcdHistory::Wanted, the default) builds on the wanted x_t, as independent implementations of it do.
+// previous_wanted and previous_drive are read only for a panel with history.
+PanelDrive drive_panel(const cv::Mat& wanted, const cv::Mat& previous_wanted, const cv::Mat& previous_drive,
+                       const Panel& panel, const PanelEmission& emission, int output_bits) {
   PanelDrive out;
   const cv::Size size = wanted.size();
+  const bool history = panel.has_history();
   out.drive.create(size, CV_64FC3);
-  out.shortfall = cv::Mat::zeros(size, CV_64FC3);
-  out.contributed = wanted.clone();
-  out.target.create(size, CV_64FC3);
-  out.unreachable = cv::Mat::zeros(size, CV_8UC3);
-  const double inverse_gamma = 1.0 / lcd.gamma;
-  const auto luminance = [&lcd](double merged) { return std::pow(std::max(merged, 0.0), lcd.gamma); };
+  if (history) {
+    out.shortfall = cv::Mat::zeros(size, CV_64FC3);
+    out.contributed = wanted.clone();
+    out.target.create(size, CV_64FC3);
+    out.unreachable = cv::Mat::zeros(size, CV_8UC3);
+    out.previous_drive = previous_drive;
+  }
   for (int y = 0; y < size.height; ++y) {
     const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
-    const cv::Vec3d* xp_row = previous_wanted.ptr<cv::Vec3d>(y);
-    const cv::Vec3d* vp_row = previous_drive.ptr<cv::Vec3d>(y);
+    const cv::Vec3d* xp_row = history ? previous_wanted.ptr<cv::Vec3d>(y) : nullptr;
+    const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
     cv::Vec3d* v_row = out.drive.ptr<cv::Vec3d>(y);
-    cv::Vec3d* s_row = out.shortfall.ptr<cv::Vec3d>(y);
-    cv::Vec3d* c_row = out.contributed.ptr<cv::Vec3d>(y);
-    cv::Vec3d* m_row = out.target.ptr<cv::Vec3d>(y);
-    cv::Vec3b* u_row = out.unreachable.ptr<cv::Vec3b>(y);
     for (int x = 0; x < size.width; ++x) {
       for (int ch = 0; ch < 3; ++ch) {
         const double x_t = x_row[x][ch];
-        const double x_prev = xp_row[x][ch];
-        const double v_prev = vp_row[x][ch];
-        const double m = std::pow(std::max(0.5 * (x_t + x_prev), 0.0), inverse_gamma);
-        const LcdPanel::Solution solution = lcd.solve(m, v_prev);
-        m_row[x][ch] = m;
-        v_row[x][ch] = solution.v;
-        if (!solution.reachable) {
+        const double x_prev = history ? xp_row[x][ch] : 0.0;
+        const PanelDriveSample sample = panel.drive(x_t, x_prev, history ? vp_row[x][ch] : 0.0, ch);
+        v_row[x][ch] = sample.v;
+        if (!history) continue;
+        out.target.ptr<cv::Vec3d>(y)[x][ch] = sample.target;
+        if (!sample.reachable) {
           ++out.unreachable_count;
-          u_row[x][ch] = 255;
-          const double x_t_effective = 2.0 * luminance(lcd.merge(solution.v, v_prev)) - x_prev;
-          s_row[x][ch] = x_t - x_t_effective;
-          c_row[x][ch] = x_t_effective;
+          out.unreachable.ptr<cv::Vec3b>(y)[x][ch] = 255;
+          out.shortfall.ptr<cv::Vec3d>(y)[x][ch] = x_t - sample.contributed;
+          out.contributed.ptr<cv::Vec3d>(y)[x][ch] = sample.contributed;
         }
       }
     }
   }
   out.codes = quantise(out.drive, output_bits);
-  out.previous_drive = previous_drive;
 
-  // Both drives are codes (v_{t-1} = code / (2^out - 1) exactly), so the emitted M(v_t, v_{t-1})^gamma takes
-  // only (2^out)^2 values: tabulate them instead of a pow per sample (same doubles).
   const int top = max_code(output_bits);
-  const std::size_t codes_per_axis = static_cast<std::size_t>(top) + 1;
-  std::vector<double> emission(codes_per_axis * codes_per_axis);
-  for (std::size_t code = 0; code < codes_per_axis; ++code) {
-    for (std::size_t previous = 0; previous < codes_per_axis; ++previous) {
-      emission[code * codes_per_axis + previous] =
-          luminance(lcd.merge(static_cast<double>(code) / top, static_cast<double>(previous) / top));
-    }
-  }
   out.emitted_linear.create(size, CV_64FC3);
   for (int y = 0; y < size.height; ++y) {
     const cv::Vec3w* q_row = out.codes.ptr<cv::Vec3w>(y);
-    const cv::Vec3d* vp_row = previous_drive.ptr<cv::Vec3d>(y);
+    const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
     cv::Vec3d* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
     for (int x = 0; x < size.width; ++x) {
       for (int ch = 0; ch < 3; ++ch) {
-        const auto previous_code = static_cast<std::size_t>(std::lround(vp_row[x][ch] * top));
-        e_row[x][ch] = emission[q_row[x][ch] * codes_per_axis + previous_code];
+        const auto previous_code = history ? static_cast<std::uint16_t>(std::lround(vp_row[x][ch] * top)) : 0;
+        e_row[x][ch] = emission(q_row[x][ch], previous_code, ch);
       }
     }
   }
@@ -432,34 +332,8 @@ void DecoderConfig::validate() const {
   validate_panel(panel, "DecoderConfig: ");
 }
 
-ReferenceDecoder::ReferenceDecoder(DecoderConfig config) : config_(std::move(config)) { config_.validate(); }
-
-namespace {
-
-// Replaces every lost row of codes: by the same row of `substitute` when given, else by the nearest intact row
-// above (or below when there is none above). Returns the number of rows replaced.
-int conceal_rows(cv::Mat& codes, std::span<const std::uint8_t> intact, const cv::Mat& substitute) {
-  int concealed = 0;
-  for (int y = 0; y < codes.rows; ++y) {
-    if (intact[static_cast<std::size_t>(y)]) continue;
-    ++concealed;
-    if (!substitute.empty()) {
-      substitute.row(y).copyTo(codes.row(y));
-      continue;
-    }
-    int source = -1;
-    for (int up = y - 1; up >= 0 && source < 0; --up) {
-      if (intact[static_cast<std::size_t>(up)]) source = up;
-    }
-    for (int down = y + 1; down < codes.rows && source < 0; ++down) {
-      if (intact[static_cast<std::size_t>(down)]) source = down;
-    }
-    codes.row(source).copyTo(codes.row(y));
-  }
-  return concealed;
-}
-
-}  // namespace
+ReferenceDecoder::ReferenceDecoder(DecoderConfig config)
+    : config_((config.validate(), std::move(config))), emission_(config_.panel, config_.output_bits) {}
 
 DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
   const cv::Size full(meta.full_width, meta.full_height);
@@ -483,34 +357,28 @@ DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
 }
 
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
-  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(frame_name(meta)).append(": "));
+  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(detail::frame_name(meta)).append(": "));
   return detail::hold_lost_view(eyes_[meta.eye], meta);
 }
 
 DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  if (line_intact.empty()) return decode(frame);
-  if (line_intact.size() != static_cast<std::size_t>(frame.codes.rows)) {
-    throw std::invalid_argument("ReferenceDecoder: line mask has " + std::to_string(line_intact.size()) +
-                                " entries for a view of " + std::to_string(frame.codes.rows) + " lines");
+  detail::Concealment lost;
+  switch (detail::classify_arrival(frame, line_intact, lost, "ReferenceDecoder")) {
+    case detail::Arrival::Whole: return decode(frame);
+    case detail::Arrival::Lost: return decode_lost(frame.meta);
+    case detail::Arrival::Partial: break;
   }
-  const auto intact_lines = std::count_if(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
-  if (intact_lines == 0) return decode_lost(frame.meta);
-  if (intact_lines == frame.codes.rows) return decode(frame);
-
-  LinkFrame concealed{frame.meta, frame.codes.clone()};
-  const EyeState& eye = eyes_[frame.meta.eye];
-  const bool reduced = frame.meta.parity == Parity::Reduced;
-  const bool have_low = reduced && eye.have_residual && eye.previous_low.size() == frame.codes.size();
-  const int lines = conceal_rows(concealed.codes, line_intact, have_low ? eye.previous_low : cv::Mat());
+  lost.substitute = detail::concealment_substitute(eyes_, frame);
+  const LinkFrame concealed{frame.meta, detail::concealed_codes(frame.codes, lost)};
   DecodedFrame out = decode_view(concealed, line_intact);
-  out.stats.concealed_lines = lines;
+  out.stats.concealed_lines = lost.lost_lines;
   return out;
 }
 
 DecodedFrame ReferenceDecoder::decode(const LinkFrame& frame) { return decode_view(frame, {}); }
 
 void ReferenceDecoder::adopt_panel_history(const DecodedFrame& shown) {
-  if (config_.panel.kind != PanelKind::Lcd) {
+  if (!config_.panel.has_history()) {
     throw std::invalid_argument("ReferenceDecoder: adopt_panel_history is for LCD panels (an OLED has no history)");
   }
   const auto found = eyes_.find(shown.meta.eye);
@@ -532,7 +400,7 @@ void ReferenceDecoder::adopt_panel_history(const DecodedFrame& shown) {
 }
 
 DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  check_link_frame(frame, config_);
+  detail::check_link_frame(frame, config_.link, "ReferenceDecoder");
   const FrameMeta& meta = frame.meta;
   const EncoderConfig& link = config_.link;
   const cv::Size full(meta.full_width, meta.full_height);
@@ -570,10 +438,12 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     eye.residual = residual;
     eye.previous_low = low_codes;
     if (config_.record_stages) {
-      stages.low_codes = low_codes;
-      stages.low_linear = low_linear;
-      stages.full_linear = full_linear;
-      stages.beta = beta;
+      stages.at(Stage::Codes) = frame.codes;
+      stages.at(Stage::Reduced) = low_codes;
+      stages.at(Stage::LowPass) = low_linear;
+      stages.at(Stage::Linear) = full_linear;
+      stages.at(Stage::Beta) = beta;
+      stages.at(Stage::Shown) = wanted;
     }
   } else {
     const cv::Mat alpha = upsampled_linear(frame.codes, full, link);  // Eq. 1
@@ -595,11 +465,11 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
       out.stats.residual_mean_abs = consumed.mean_abs;
       out.stats.residual_max_abs = consumed.max_abs;
       if (config_.record_stages) {
-        stages.residual = eye.residual;
-        stages.previous_low_linear = previous_low_linear;
-        stages.contrast = contrast;
-        stages.weight = weight;
-        stages.alpha_unclamped = added.alpha_unclamped;
+        stages.at(Stage::Residual) = eye.residual;
+        stages.at(Stage::PreviousLowPass) = previous_low_linear;
+        stages.at(Stage::Contrast) = contrast;
+        stages.at(Stage::Weight) = weight;
+        stages.at(Stage::AlphaUnclamped) = added.alpha_unclamped;
       }
     } else {
       // No full frame just before this one (stream start, lost frame, two reduced in a row): alpha alone.
@@ -611,29 +481,28 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     eye.residual.release();
     eye.previous_low.release();
     if (config_.record_stages) {
-      stages.low_codes = frame.codes;
-      stages.low_linear = alpha;
+      stages.at(Stage::Codes) = frame.codes;
+      stages.at(Stage::Alpha) = alpha;
+      stages.at(Stage::AlphaPrime) = wanted;
     }
   }
 
-  PanelDrive drive;
-  if (config_.panel.kind == PanelKind::Oled) {
-    drive = drive_oled(wanted, config_.panel, config_.output_bits);
-  } else {
-    if (eye.previous_drive.empty()) {
-      std::tie(eye.previous_wanted, eye.previous_drive) = held_history(wanted, config_.panel, config_.output_bits);
-    }
-    const cv::Mat previous_linear = eye.previous_wanted;
-    drive = drive_lcd(wanted, previous_linear, eye.previous_drive, config_.panel.lcd, config_.output_bits);
+  if (config_.panel.has_history() && eye.previous_drive.empty()) {
+    std::tie(eye.previous_wanted, eye.previous_drive) = held_history(wanted, config_.panel, config_.output_bits);
+  }
+  const cv::Mat previous_linear = eye.previous_wanted;
+  const PanelDrive drive =
+      drive_panel(wanted, previous_linear, eye.previous_drive, config_.panel, emission_, config_.output_bits);
+  if (config_.panel.has_history()) {
     out.stats.lcd_unreachable_fraction = static_cast<double>(drive.unreachable_count) / samples;
     if (meta.parity == Parity::Full && drive.unreachable_count > 0) add_shortfall(eye.residual, drive.shortfall);
     eye.previous_wanted = config_.lcd_history == LcdHistory::Contributed ? drive.contributed : wanted;
     eye.previous_drive = dequantise(drive.codes, config_.output_bits);
     if (config_.record_stages) {
-      stages.lcd_target = drive.target;
-      stages.lcd_previous_drive = drive.previous_drive;
-      stages.lcd_previous_linear = previous_linear;
-      stages.lcd_unreachable = drive.unreachable;
+      stages.at(Stage::LcdTarget) = drive.target;
+      stages.at(Stage::LcdPreviousDrive) = drive.previous_drive;
+      stages.at(Stage::LcdPreviousLinear) = previous_linear;
+      stages.at(Stage::LcdUnreachable) = drive.unreachable;
     }
   }
 
@@ -641,7 +510,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     const ResidualSummary kept = summarise_residual(eye.residual);
     out.stats.residual_mean_abs = kept.mean_abs;
     out.stats.residual_max_abs = kept.max_abs;
-    if (config_.record_stages) stages.residual = eye.residual.clone();
+    if (config_.record_stages) stages.at(Stage::Residual) = eye.residual.clone();
   }
 
   out.wanted_linear = wanted;
@@ -649,7 +518,10 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   out.drive_codes = drive.codes;
   out.emitted_linear = drive.emitted_linear;
   eye.last_output = out;
-  if (config_.record_stages) out.stages = std::move(stages);
+  if (config_.record_stages) {
+    stages.at(Stage::Drive) = drive.codes;
+    out.stages = std::move(stages);
+  }
   return out;
 }
 

@@ -1,12 +1,15 @@
 // Panel models (DESIGN §4 "Panel drive", paper Sec. 4.4) in double precision.
 #include "trm/panel.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace trm {
@@ -34,7 +37,7 @@ constexpr double kReachedTolerance = 1e-14;
 constexpr double kNegligibleQuadratic = 0x1p-80;
 
 // 'text' (built by appending: GCC 12 misreports "literal" + std::string&& under -Wrestrict).
-std::string quoted(std::string_view text) {
+std::string in_quotes(std::string_view text) {
   std::string out("'");
   out.append(text);
   out.push_back('\'');
@@ -57,7 +60,7 @@ std::string accepted_forms() {
 
 [[noreturn]] void reject(const std::string& spec, const std::string& why) {
   std::string message("invalid panel ");
-  message.append(quoted(spec)).append(": ").append(why).append("; ").append(accepted_forms());
+  message.append(in_quotes(spec)).append(": ").append(why).append("; ").append(accepted_forms());
   throw std::invalid_argument(message);
 }
 
@@ -71,9 +74,9 @@ std::vector<double> parse_numbers(const std::string& spec, std::string_view list
     const char* end = item.data() + item.size();
     const auto [ptr, ec] = std::from_chars(item.data(), end, value);
     if (item.empty() || ec != std::errc() || ptr != end) {
-      reject(spec, quoted(item) + " is not a number");
+      reject(spec, in_quotes(item) + " is not a number");
     }
-    if (!std::isfinite(value)) reject(spec, "parameters must be finite (got " + quoted(item) + ")");
+    if (!std::isfinite(value)) reject(spec, "parameters must be finite (got " + in_quotes(item) + ")");
     values.push_back(value);
     if (comma == std::string_view::npos) break;
     list.remove_prefix(comma + 1);
@@ -154,63 +157,156 @@ LcdPanel::Solution LcdPanel::solve(double m, double v_prev) const {
   return best;
 }
 
+double LcdPanel::luminance(double merged) const { return std::pow(std::max(merged, 0.0), gamma); }
+
+double LcdPanel::target(double x_t, double x_prev) const {
+  return std::pow(std::max(0.5 * (x_t + x_prev), 0.0), 1.0 / gamma);
+}
+
+// The pair (v_{t-1}, v_t) is seen as the merged value M(v_t, v_{t-1}) with luminance M^gamma, the time average of the
+// two frames. To add x_t after a frame that contributed x_{t-1}, the pair must merge to m; v_{t-1} is the drive
+// actually shown. Where m is unreachable v_t is clamped to the closest attainable merge, and the pair then averages
+// to M(v_t, v_{t-1})^gamma: frame t effectively contributed x_t_eff = 2 M(v_t, v_{t-1})^gamma - x_{t-1}.
+PanelDriveSample LcdPanel::drive(double x_t, double x_prev, double v_prev) const {
+  PanelDriveSample out;
+  out.target = target(x_t, x_prev);
+  const Solution solution = solve(out.target, v_prev);
+  out.v = solution.v;
+  out.reachable = solution.reachable;
+  out.contributed = solution.reachable ? x_t : 2.0 * emitted(solution.v, v_prev) - x_prev;
+  return out;
+}
+
+LcdPanel LcdPanel::held() const {
+  LcdPanel out;
+  out.p1 = 2.0 * p1 + p2;
+  out.p2 = 0.0;
+  out.p3 = 2.0 * p3;
+  out.p4 = p4;
+  out.gamma = gamma;
+  return out;
+}
+
+cv::Mat LcdPanel::merged_of_emission(const cv::Mat& emitted) const {
+  cv::Mat merged;
+  cv::pow(emitted, 1.0 / gamma, merged);
+  return merged;
+}
+
+double OledPanel::emitted(double v, int channel) const {
+  return std::pow(v, gamma.at(static_cast<std::size_t>(channel)));
+}
+
+double OledPanel::drive(double x, int channel) const {
+  return std::pow(std::clamp(x, 0.0, 1.0), 1.0 / gamma.at(static_cast<std::size_t>(channel)));
+}
+
+std::array<double, 3> Panel::channel_gammas() const {
+  return kind == PanelKind::Oled ? oled.gamma : std::array<double, 3>{lcd.gamma, lcd.gamma, lcd.gamma};
+}
+
+PanelDriveSample Panel::drive(double x_t, double x_prev, double v_prev, int channel) const {
+  if (kind == PanelKind::Lcd) return lcd.drive(x_t, x_prev, v_prev);
+  PanelDriveSample out;
+  out.v = oled.drive(x_t, channel);
+  out.target = out.v;
+  out.contributed = x_t;
+  return out;
+}
+
+double Panel::emitted(double v, double v_prev, int channel) const {
+  return kind == PanelKind::Lcd ? lcd.emitted(v, v_prev) : oled.emitted(v, channel);
+}
+
 double Panel::linear_from_drive(double v, int channel) const {
-  if (kind == PanelKind::Oled) return std::pow(v, oled.gamma.at(static_cast<std::size_t>(channel)));
-  // A held LCD pixel: the merge of the frame with itself. Negative merged values emit no light.
-  return std::pow(std::max(lcd.merge(v, v), 0.0), lcd.gamma);
+  return kind == PanelKind::Lcd ? lcd.emitted(v, v) : oled.emitted(v, channel);
 }
 
 double Panel::drive_from_linear(double x, int channel) const {
-  const double clamped = std::clamp(x, 0.0, 1.0);
-  if (kind == PanelKind::Oled) return std::pow(clamped, 1.0 / oled.gamma.at(static_cast<std::size_t>(channel)));
-  // Held LCD pixel: solve M(v, v) = x^(1/gamma), i.e. (2 p1 + p2) v^2 + 2 p3 v + p4 = m. With the default
-  // parameters M(v, v) = v and this is v = x^(1/gamma). M(v, v) is the merge with p1' = 2 p1 + p2, p2' = 0,
-  // p3' = 2 p3, p4' = p4 evaluated at v_prev = 0, which reuses the stable solver.
-  LcdPanel held;
-  held.p1 = 2.0 * lcd.p1 + lcd.p2;
-  held.p2 = 0.0;
-  held.p3 = 2.0 * lcd.p3;
-  held.p4 = lcd.p4;
-  held.gamma = lcd.gamma;
-  return held.solve(std::pow(clamped, 1.0 / lcd.gamma), 0.0).v;
+  if (kind == PanelKind::Oled) return oled.drive(x, channel);
+  // Held LCD pixel: solve M(v, v) = x^(1/gamma). With the default parameters M(v, v) = v and this is
+  // v = x^(1/gamma).
+  return lcd.held().solve(std::pow(std::clamp(x, 0.0, 1.0), 1.0 / lcd.gamma), 0.0).v;
 }
 
-void validate_panel(const Panel& panel, const std::string& what) {
-  const auto fail = [&](const std::string& why) { throw std::invalid_argument(what + why); };
-  const auto check_gamma = [&](double gamma, const char* name) {
-    if (!(gamma > 0.0) || !std::isfinite(gamma)) fail(std::string(name) + " must be > 0 and finite");
-    if (gamma < kMinPanelGamma || gamma > kMaxPanelGamma) {
-      fail(std::string(name) + " " + number_text(gamma) + " is outside [" + number_text(kMinPanelGamma) + ", " +
-           number_text(kMaxPanelGamma) + "], the display gammas trm models");
+cv::Mat Panel::perceived_pair(const cv::Mat& first_emitted, const cv::Mat& second_emitted) const {
+  if (kind == PanelKind::Lcd) return second_emitted.clone();
+  return trm::perceived_pair(first_emitted, second_emitted);
+}
+
+bool operator==(const Panel& a, const Panel& b) {
+  if (a.kind != b.kind || a.name != b.name) return false;
+  return a.kind == PanelKind::Oled ? a.oled == b.oled : a.lcd == b.lcd;
+}
+
+PanelEmission::PanelEmission(const Panel& panel, int output_bits)
+    : codes_(static_cast<std::size_t>(1) << output_bits), history_(panel.has_history()) {
+  const int top = (1 << output_bits) - 1;
+  if (history_) {
+    // Both drives are codes (v_{t-1} = code / (2^out - 1) exactly), so M(v_t, v_{t-1})^gamma takes only (2^out)^2
+    // values.
+    table_.resize(codes_ * codes_);
+    for (std::size_t code = 0; code < codes_; ++code) {
+      for (std::size_t previous = 0; previous < codes_; ++previous) {
+        table_[code * codes_ + previous] =
+            panel.emitted(static_cast<double>(code) / top, static_cast<double>(previous) / top, 0);
+      }
     }
-  };
-  if (panel.kind == PanelKind::Oled) {
-    for (double gamma : panel.oled.gamma) check_gamma(gamma, "OLED gamma");
-    if (!(panel.oled.duty > 0.0 && panel.oled.duty <= 1.0)) fail("OLED duty must be in (0, 1]");
     return;
   }
-  const LcdPanel& lcd = panel.lcd;
-  for (double p : {lcd.p1, lcd.p2, lcd.p3, lcd.p4}) {
+  table_.resize(3 * codes_);
+  for (int ch = 0; ch < 3; ++ch) {
+    for (std::size_t code = 0; code < codes_; ++code) {
+      table_[static_cast<std::size_t>(ch) * codes_ + code] = panel.emitted(static_cast<double>(code) / top, 0.0, ch);
+    }
+  }
+}
+
+namespace {
+
+void check_gamma(double gamma, const char* name, const std::string& what) {
+  if (!(gamma > 0.0) || !std::isfinite(gamma)) throw std::invalid_argument(what + name + " must be > 0 and finite");
+  if (gamma < kMinPanelGamma || gamma > kMaxPanelGamma) {
+    throw std::invalid_argument(what + name + " " + number_text(gamma) + " is outside [" +
+                                number_text(kMinPanelGamma) + ", " + number_text(kMaxPanelGamma) +
+                                "], the display gammas trm models");
+  }
+}
+
+}  // namespace
+
+void OledPanel::validate(const std::string& what) const {
+  for (double g : gamma) check_gamma(g, "OLED gamma", what);
+  if (!(duty > 0.0 && duty <= 1.0)) throw std::invalid_argument(what + "OLED duty must be in (0, 1]");
+}
+
+void LcdPanel::validate(const std::string& what) const {
+  const auto fail = [&](const std::string& why) { throw std::invalid_argument(what + why); };
+  for (double p : {p1, p2, p3, p4}) {
     if (!std::isfinite(p)) fail("LCD parameters p1..p4 must be finite");
     if (std::abs(p) > kMaxLcdCoefficient) {
       fail("LCD merge coefficients p1..p4 must be within [-" + number_text(kMaxLcdCoefficient) + ", " +
            number_text(kMaxLcdCoefficient) + "]");
     }
   }
-  check_gamma(lcd.gamma, "LCD gamma");
+  check_gamma(gamma, "LCD gamma", what);
   // dM/dv_t = 2 p1 v_t + p2 v_prev + p3 is linear in both: positive at the four corners means positive on [0, 1]^2.
   for (double v : {0.0, 1.0}) {
     for (double vp : {0.0, 1.0}) {
-      if (!(2.0 * lcd.p1 * v + lcd.p2 * vp + lcd.p3 > 0.0)) {
+      if (!(2.0 * p1 * v + p2 * vp + p3 > 0.0)) {
         fail("the LCD merge M(v_t, v_prev) must be increasing in v_t on [0, 1] (dM/dv_t = 2 p1 v_t + p2 v_prev + p3 "
              "> 0), or the drive has no unique inverse");
       }
     }
-    if (!(2.0 * (2.0 * lcd.p1 + lcd.p2) * v + 2.0 * lcd.p3 > 0.0)) {
-      fail("the held LCD merge M(v, v) must be increasing on [0, 1]");
-    }
+    if (!(2.0 * (2.0 * p1 + p2) * v + 2.0 * p3 > 0.0)) fail("the held LCD merge M(v, v) must be increasing on [0, 1]");
   }
 }
+
+void Panel::validate(const std::string& what) const {
+  if (kind == PanelKind::Oled) oled.validate(what); else lcd.validate(what);
+}
+
+void validate_panel(const Panel& panel, const std::string& what) { panel.validate(what); }
 
 Panel parse_panel(const std::string& spec) {
   Panel panel = parse_panel_spec(spec);
@@ -259,6 +355,73 @@ Panel parse_panel_spec(const std::string& spec) {
 }
 
 }  // namespace
+
+namespace {
+
+template <typename Json>
+void write_panel(Json& out, const Panel& panel) {
+  if (panel.kind == PanelKind::Oled) {
+    out = {{"kind", "oled"}, {"name", panel.name}, {"gamma", panel.oled.gamma}, {"duty", panel.oled.duty}};
+    return;
+  }
+  const LcdPanel& lcd = panel.lcd;
+  out = {{"kind", "lcd"}, {"name", panel.name}, {"p1", lcd.p1}, {"p2", lcd.p2},
+         {"p3", lcd.p3},  {"p4", lcd.p4},       {"gamma", lcd.gamma}};
+}
+
+[[noreturn]] void reject_json(const std::string& why) { throw std::invalid_argument("panel JSON: " + why); }
+
+template <typename Json>
+const Json& field(const Json& in, const char* key) {
+  const auto found = in.find(key);
+  if (found == in.end()) reject_json(std::string("missing \"") + key + "\"");
+  return *found;
+}
+
+template <typename Json>
+double number_field(const Json& in, const char* key) {
+  const Json& value = field(in, key);
+  if (!value.is_number()) reject_json(std::string("\"") + key + "\" must be a number, got " + value.dump());
+  return value.template get<double>();
+}
+
+template <typename Json>
+void read_panel(const Json& in, Panel& panel) {
+  if (!in.is_object()) reject_json("expected an object, got " + in.dump());
+  const Json& kind = field(in, "kind");
+  const Json& name = field(in, "name");
+  if (!name.is_string()) reject_json("\"name\" must be a string, got " + name.dump());
+  Panel out;
+  out.name = name.template get<std::string>();
+  if (kind == "oled") {
+    out.kind = PanelKind::Oled;
+    const Json& gamma = field(in, "gamma");
+    if (!gamma.is_array() || gamma.size() != 3) reject_json("\"gamma\" of an OLED panel must be 3 numbers (R, G, B)");
+    for (std::size_t c = 0; c < 3; ++c) {
+      if (!gamma[c].is_number()) reject_json("\"gamma\" of an OLED panel must be 3 numbers (R, G, B)");
+      out.oled.gamma[c] = gamma[c].template get<double>();
+    }
+    out.oled.duty = number_field(in, "duty");
+  } else if (kind == "lcd") {
+    out.kind = PanelKind::Lcd;
+    out.lcd.p1 = number_field(in, "p1");
+    out.lcd.p2 = number_field(in, "p2");
+    out.lcd.p3 = number_field(in, "p3");
+    out.lcd.p4 = number_field(in, "p4");
+    out.lcd.gamma = number_field(in, "gamma");
+  } else {
+    reject_json("\"kind\" must be \"oled\" or \"lcd\", got " + kind.dump());
+  }
+  out.validate("panel JSON: ");
+  panel = std::move(out);
+}
+
+}  // namespace
+
+void to_json(nlohmann::json& out, const Panel& panel) { write_panel(out, panel); }
+void to_json(nlohmann::ordered_json& out, const Panel& panel) { write_panel(out, panel); }
+void from_json(const nlohmann::json& in, Panel& panel) { read_panel(in, panel); }
+void from_json(const nlohmann::ordered_json& in, Panel& panel) { read_panel(in, panel); }
 
 cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b) {
   if (linear_a.size() != linear_b.size() || linear_a.type() != linear_b.type() || linear_a.depth() != CV_64F) {

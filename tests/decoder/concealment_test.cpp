@@ -27,11 +27,11 @@ TEST(Concealment, LostFullFrameLinesShowTheLowPassEstimateAndClearTheirResidual)
   EXPECT_EQ(d.stats.concealed_lines, 3);
   for (int y : {0, 7, 15}) {
     // beta of a lost line is L_t, which lies in [0, 1]: shown = L_t, rho = 0.
-    EXPECT_EQ(test::max_abs_difference(d.wanted_linear.row(y), d.stages->low_linear.row(y)), 0.0) << y;
-    EXPECT_EQ(cv::norm(d.stages->residual.row(y), cv::NORM_INF), 0.0) << y;
+    EXPECT_EQ(test::max_abs_difference(d.wanted_linear.row(y), d.stages->at(Stage::LowPass).row(y)), 0.0) << y;
+    EXPECT_EQ(cv::norm(d.stages->at(Stage::Residual).row(y), cv::NORM_INF), 0.0) << y;
   }
   // Intact lines keep their residual.
-  EXPECT_GT(cv::norm(d.stages->residual.row(3), cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(d.stages->at(Stage::Residual).row(3), cv::NORM_INF), 0.0);
 }
 
 TEST(Concealment, LostReducedFrameLinesRepeatThePreviousLowPassFrame) {

@@ -105,7 +105,7 @@ TEST(FixedConcealment, FollowsTheReferenceRules) {
   const DecodedFrame expected_full = reference.decode(test::damaged(full, mask), mask);
   ASSERT_TRUE(expected_full.stages);
   for (int y : {0, 7, 15}) {
-    EXPECT_LE(test::max_abs_difference(got.wanted_linear.row(y), expected_full.stages->low_linear.row(y)), 1e-5) << y;
+    EXPECT_LE(test::max_abs_difference(got.wanted_linear.row(y), expected_full.stages->at(Stage::LowPass).row(y)), 1e-5) << y;
   }
   // Static content: the stored d_t equals the reduced frame, so repeating its rows conceals perfectly.
   const LinkFrame reduced = encoder.encode(image, 1);

@@ -293,9 +293,9 @@ TEST(FixedExtremes, SingleBrightPixelOvershootAndUndershoot) {
       const std::vector<LinkFrame> frames = encode_sequence(repeated(image, 4), link);
 
       const FullFrameTaps full = full_frame_taps(frames[0], config);
-      const FixedStagePlane& beta = full.taps[FixedStage::Beta];
-      const FixedStagePlane& shown = full.taps[FixedStage::Shown];
-      const FixedStagePlane& rho = full.taps[FixedStage::Residual];
+      const FixedStagePlane& beta = full.taps[Stage::Beta];
+      const FixedStagePlane& shown = full.taps[Stage::Shown];
+      const FixedStagePlane& rho = full.taps[Stage::Residual];
       const double one = std::ldexp(1.0, config.linear_frac_bits);
       const auto [lowest, highest] = std::minmax_element(beta.values.begin(), beta.values.end());
       EXPECT_GE(static_cast<double>(*highest) / one, 1.8) << what;  // maximal overshoot: beta = 2 - L
@@ -349,9 +349,9 @@ TEST(FixedExtremes, NarrowResidualStoresCountExactlyTheSamplesOutsideTheirRange)
       const std::vector<LinkFrame> frames = encode_sequence(repeated(image, 4), link);
 
       const FullFrameTaps full = full_frame_taps(frames[0], config);
-      const FixedStagePlane& beta = full.taps[FixedStage::Beta];
-      const FixedStagePlane& shown = full.taps[FixedStage::Shown];
-      const FixedStagePlane& rho = full.taps[FixedStage::Residual];
+      const FixedStagePlane& beta = full.taps[Stage::Beta];
+      const FixedStagePlane& shown = full.taps[Stage::Shown];
+      const FixedStagePlane& rho = full.taps[Stage::Residual];
       std::uint64_t saturated = 0;
       std::uint64_t rounded = 0;
       for (std::size_t k = 0; k < rho.values.size(); ++k) {
@@ -964,7 +964,7 @@ TEST(FixedExtremes, ExactHalfCodeTiesOfD) {
         }
       }
       const FullFrameTaps taps = full_frame_taps(frame, fixed_config(c.link));
-      const std::vector<std::int64_t>& fixed_d = taps.taps[FixedStage::Reduced].values;
+      const std::vector<std::int64_t>& fixed_d = taps.taps[Stage::Reduced].values;
       const cv::Mat expected = reduce_codes(frame.codes, c.link).reshape(1, 1);
       ASSERT_EQ(fixed_d.size(), expected.total()) << c.what;
       for (std::size_t i = 0; i < fixed_d.size(); ++i) {

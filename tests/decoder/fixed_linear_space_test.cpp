@@ -71,7 +71,7 @@ TEST(FixedLinearSpace, ReducedFrameIsTheEncodersCodeForCode) {
           FixedStageTaps taps;
           decoder.decode(frame, taps);
           const cv::Mat expected = reduce_codes(frame.codes, link).reshape(1);
-          const std::vector<std::int64_t>& d = taps[FixedStage::Reduced].values;
+          const std::vector<std::int64_t>& d = taps[Stage::Reduced].values;
           ASSERT_EQ(d.size(), expected.total());
           int differing = 0;
           for (int y = 0; y < expected.rows; ++y) {

@@ -183,7 +183,7 @@ TEST(FixedSkip, CountsAreExactOnAConstructedCase) {
   FixedFrameDecoder tapping(with_skip(config, false));
   FixedStageTaps taps;
   tapping.decode(full, taps);
-  const FixedStagePlane& d = taps[FixedStage::Reduced];
+  const FixedStagePlane& d = taps[Stage::Reduced];
   ASSERT_EQ(d.size, cv::Size(8, 8));
   LinkFrame reduced;
   reduced.meta = full.meta;
@@ -199,7 +199,7 @@ TEST(FixedSkip, CountsAreExactOnAConstructedCase) {
     }
   }
   int residual_lines = 0;
-  const FixedStagePlane& rho = taps[FixedStage::Residual];
+  const FixedStagePlane& rho = taps[Stage::Residual];
   for (int y = 0; y < 16; ++y) {
     bool nonzero = false;
     for (int i = 0; i < 48; ++i) nonzero = nonzero || rho.values[static_cast<std::size_t>(y * 48 + i)] != 0;

@@ -1,6 +1,7 @@
 // The stage taps of the frame-at-a-time fixed-point decoder (the source of the golden vectors) and the hardware
 // report's ROMs, arithmetic and frame-store comparison.
 #include "trm/fixed_decoder.hpp"
+#include "trm/reference_decoder.hpp"
 
 #include "decoder_test_support.hpp"
 
@@ -45,8 +46,8 @@ void check_sequence(const std::string& panel) {
     const DecodedFrame b = plain.decode(frame);
     ASSERT_EQ(cv::norm(a.drive_codes, b.drive_codes, cv::NORM_INF), 0.0);
     const bool full = frame.meta.parity == Parity::Full;
-    const FixedStagePlane& drive = taps[FixedStage::Drive];
-    const FixedStagePlane& codes = taps[FixedStage::Codes];
+    const FixedStagePlane& drive = taps[Stage::Drive];
+    const FixedStagePlane& codes = taps[Stage::Codes];
     ASSERT_TRUE(drive.present && codes.present);
     EXPECT_EQ(codes.size, frame.codes.size());
     for (int y = 0; y < height; ++y) {
@@ -55,11 +56,11 @@ void check_sequence(const std::string& panel) {
         ASSERT_EQ(drive.values[i], a.drive_codes.ptr<std::uint16_t>(y)[k]);
         const std::int64_t wanted = raw_at(a.wanted_linear, y, k, F);
         if (full) {
-          const auto& beta = taps[FixedStage::Beta].values;
-          const auto& shown = taps[FixedStage::Shown].values;
-          const auto& rho = taps[FixedStage::Residual].values;
-          const auto& I = taps[FixedStage::Linear].values;
-          const auto& L = taps[FixedStage::LowPass].values;
+          const auto& beta = taps[Stage::Beta].values;
+          const auto& shown = taps[Stage::Shown].values;
+          const auto& rho = taps[Stage::Residual].values;
+          const auto& I = taps[Stage::Linear].values;
+          const auto& L = taps[Stage::LowPass].values;
           ASSERT_EQ(beta[i], 2 * I[i] - L[i]);
           ASSERT_EQ(shown[i], std::clamp<std::int64_t>(beta[i], 0, std::int64_t{1} << F));
           ASSERT_EQ(shown[i], wanted);
@@ -67,20 +68,61 @@ void check_sequence(const std::string& panel) {
             ASSERT_EQ(rho[i], beta[i] - shown[i]);  // the default store sQ2.F holds rho exactly
           }
         } else {
-          ASSERT_EQ(taps[FixedStage::AlphaPrime].values[i], wanted);
+          ASSERT_EQ(taps[Stage::AlphaPrime].values[i], wanted);
         }
       }
     }
     if (!full) {
-      ASSERT_TRUE(taps[FixedStage::Weight].present);
-      const auto& c = taps[FixedStage::Contrast].values;
-      const auto& w = taps[FixedStage::Weight].values;
+      ASSERT_TRUE(taps[Stage::Weight].present);
+      const auto& c = taps[Stage::Contrast].values;
+      const auto& w = taps[Stage::Weight].values;
       if (t == 3) {  // static pair: nothing moved, c = 0 and w = 1 everywhere
         EXPECT_EQ(*std::max_element(c.begin(), c.end()), 0);
         EXPECT_EQ(*std::min_element(w.begin(), w.end()), std::int64_t{1} << F);
       } else {
         EXPECT_GT(*std::max_element(c.begin(), c.end()), 0);
         EXPECT_LT(*std::min_element(w.begin(), w.end()), std::int64_t{1} << F);
+      }
+    }
+  }
+}
+
+// Both decoders record their stages in one vocabulary: every stage the fixed-point taps hold the reference records
+// too, for the same frame kind, at the same size and channel count, and the integer stages (codes, d_t, drive
+// codes) agree exactly where the two decoders compute the same thing.
+TEST(StageVocabulary, ReferenceRecordsEveryTappedStage) {
+  for (const char* panel : {"vive", "lcd"}) {
+    FixedDecoderConfig config = taps_config(panel);
+    FixedFrameDecoder tapped(config);
+    config.decoder.record_stages = true;
+    ReferenceDecoder reference(config.decoder);
+    const TrmEncoder encoder(config.decoder.link);
+    for (std::int64_t t = 0; t < 2; ++t) {
+      SCOPED_TRACE(std::string(panel) + " frame " + std::to_string(t));
+      const LinkFrame frame = encoder.encode(test::random_image(21, 14, 11), t, 0);
+      FixedStageTaps taps;
+      (void)tapped.decode(frame, taps);
+      const DecodedFrame recorded = reference.decode(frame);
+      ASSERT_TRUE(recorded.stages);
+      for (int k = 0; k < kStageCount; ++k) {
+        const auto stage = static_cast<Stage>(k);
+        const FixedStagePlane& plane = taps[stage];
+        if (!plane.present) continue;
+        EXPECT_EQ(plane.name, stage_name(stage));
+        const cv::Mat& m = recorded.stages->at(stage);
+        ASSERT_FALSE(m.empty()) << stage_name(stage);
+        EXPECT_EQ(m.size(), plane.size) << stage_name(stage);
+        EXPECT_EQ(m.channels(), plane.channels) << stage_name(stage);
+      }
+      for (Stage stage : {Stage::Codes, Stage::Reduced}) {
+        if (!taps[stage].present) continue;
+        const cv::Mat& m = recorded.stages->at(stage);
+        for (int y = 0; y < m.rows; ++y) {
+          for (int i = 0; i < 3 * m.cols; ++i) {
+            ASSERT_EQ(taps[stage].values[static_cast<std::size_t>(y * 3 * m.cols + i)], m.ptr<std::uint16_t>(y)[i])
+                << stage_name(stage);
+          }
+        }
       }
     }
   }
@@ -97,11 +139,11 @@ TEST(FixedTaps, ReducedFrameWithoutResidualHasNoMotionStages) {
   const TrmEncoder encoder(link);
   FixedStageTaps taps;
   decoder.decode(encoder.encode(test::random_image(9, 7, 3), 0, 0), taps);
-  EXPECT_TRUE(taps[FixedStage::Alpha].present);
-  EXPECT_TRUE(taps[FixedStage::AlphaPrime].present);
-  EXPECT_FALSE(taps[FixedStage::Contrast].present);
-  EXPECT_FALSE(taps[FixedStage::Weight].present);
-  EXPECT_FALSE(taps[FixedStage::Beta].present);
+  EXPECT_TRUE(taps[Stage::Alpha].present);
+  EXPECT_TRUE(taps[Stage::AlphaPrime].present);
+  EXPECT_FALSE(taps[Stage::Contrast].present);
+  EXPECT_FALSE(taps[Stage::Weight].present);
+  EXPECT_FALSE(taps[Stage::Beta].present);
 }
 
 TEST(FixedHardwareReport, RomsArithmeticAndFrameStores) {

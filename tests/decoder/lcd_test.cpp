@@ -28,18 +28,18 @@ void check_lcd_frame(const DecodedFrame& d, const LcdPanel& lcd, int output_bits
     for (int x = 0; x < d.drive.cols; ++x) {
       for (int ch = 0; ch < 3; ++ch) {
         const double wanted = d.wanted_linear.at<cv::Vec3d>(y, x)[ch];
-        const double previous = s.lcd_previous_linear.at<cv::Vec3d>(y, x)[ch];
-        const double v_prev = s.lcd_previous_drive.at<cv::Vec3d>(y, x)[ch];
+        const double previous = s.at(Stage::LcdPreviousLinear).at<cv::Vec3d>(y, x)[ch];
+        const double v_prev = s.at(Stage::LcdPreviousDrive).at<cv::Vec3d>(y, x)[ch];
         const double v = d.drive.at<cv::Vec3d>(y, x)[ch];
         const double m = std::pow(std::max(0.5 * (wanted + previous), 0.0), 1.0 / lcd.gamma);
-        ASSERT_NEAR(s.lcd_target.at<cv::Vec3d>(y, x)[ch], m, 1e-15);
+        ASSERT_NEAR(s.at(Stage::LcdTarget).at<cv::Vec3d>(y, x)[ch], m, 1e-15);
         // The previous drive is a code: the panel only ever shows quantised drives.
         ASSERT_EQ(v_prev * top, std::round(v_prev * top));
         const double code = d.drive_codes.at<cv::Vec3w>(y, x)[ch];
         ASSERT_EQ(code, std::floor(v * top + 0.5));
         ASSERT_NEAR(d.emitted_linear.at<cv::Vec3d>(y, x)[ch],
                     std::pow(std::max(lcd.merge(code / top, v_prev), 0.0), lcd.gamma), 1e-15);
-        if (s.lcd_unreachable.at<cv::Vec3b>(y, x)[ch] == 0) {
+        if (s.at(Stage::LcdUnreachable).at<cv::Vec3b>(y, x)[ch] == 0) {
           ++reachable;
           ASSERT_NEAR(lcd.merge(v, v_prev), m, 1e-12);
           // The pair (t-1, t) averages to (x_t + x_{t-1}) / 2 within output quantisation.
@@ -84,12 +84,12 @@ TEST(LcdDrive, FirstFrameIsTreatedAsHeld) {
   ReferenceDecoder decoder(config);
   const DecodedFrame d = decoder.decode(TrmEncoder(link).encode(test::random_image(10, 8, 33), 0));
   ASSERT_TRUE(d.stages);
-  EXPECT_EQ(max_abs_difference(d.stages->lcd_previous_linear, d.wanted_linear), 0.0);
+  EXPECT_EQ(max_abs_difference(d.stages->at(Stage::LcdPreviousLinear), d.wanted_linear), 0.0);
   // v_{t-1}: the held drive of x_t (M(v, v) = v for the defaults, so x^(1/gamma)), quantised.
   cv::Mat held_drive;
   cv::pow(d.wanted_linear, 1.0 / config.panel.lcd.gamma, held_drive);
   const cv::Mat held_codes = quantise(held_drive, config.output_bits);
-  EXPECT_LE(max_abs_difference(d.stages->lcd_previous_drive, dequantise(held_codes, config.output_bits)), 1e-15);
+  EXPECT_LE(max_abs_difference(d.stages->at(Stage::LcdPreviousDrive), dequantise(held_codes, config.output_bits)), 1e-15);
   EXPECT_EQ(d.stats.lcd_unreachable_fraction, 0.0);
   // Solving against its own held drive lands within a code of it.
   EXPECT_LE(cv::norm(d.drive_codes, held_codes, cv::NORM_INF), 1.0);
@@ -119,14 +119,14 @@ TEST(LcdDrive, UnreachableFullFramePushesTheShortfallIntoRho) {
   EXPECT_EQ(full.stats.lcd_unreachable_fraction, 1.0);
   EXPECT_EQ(full.drive_codes.at<cv::Vec3w>(5, 5)[1], 255);
   ASSERT_TRUE(full.stages);
-  EXPECT_NEAR(full.stages->residual.at<cv::Vec3d>(5, 5)[1], x2 - x2_effective, 1e-12);
+  EXPECT_NEAR(full.stages->at(Stage::Residual).at<cv::Vec3d>(5, 5)[1], x2 - x2_effective, 1e-12);
   EXPECT_NEAR(full.stats.residual_max_abs, x2 - x2_effective, 1e-12);
 
   // The next reduced frame is static (w = 1) and carries the shortfall: alpha' = alpha + rho = 2 x2 - x2_eff.
   ASSERT_TRUE(reduced.stats.residual_applied);
   const double alpha_prime = reduced.wanted_linear.at<cv::Vec3d>(5, 5)[1];
   EXPECT_NEAR(alpha_prime, 2.0 * x2 - x2_effective, 1e-12);
-  EXPECT_NEAR(reduced.stages->lcd_previous_linear.at<cv::Vec3d>(5, 5)[1], x2_effective, 1e-12);
+  EXPECT_NEAR(reduced.stages->at(Stage::LcdPreviousLinear).at<cv::Vec3d>(5, 5)[1], x2_effective, 1e-12);
   EXPECT_EQ(reduced.stats.lcd_unreachable_fraction, 0.0);
   // So the (full, reduced) pair averages to the wanted grey, where without the shortfall it would average to
   // (x2 + x2_eff) / 2, far too dark.
@@ -155,7 +155,7 @@ TEST(LcdDrive, DesignRuleBuildsOnTheWantedPreviousValue) {
   const double x2 = full.wanted_linear.at<cv::Vec3d>(5, 5)[1];
   const double x2_effective = 2.0 * std::pow(lcd.p1 + lcd.p3, lcd.gamma);
   ASSERT_TRUE(reduced.stages);
-  EXPECT_EQ(reduced.stages->lcd_previous_linear.at<cv::Vec3d>(5, 5)[1], x2);
+  EXPECT_EQ(reduced.stages->at(Stage::LcdPreviousLinear).at<cv::Vec3d>(5, 5)[1], x2);
   const double alpha_prime = reduced.wanted_linear.at<cv::Vec3d>(5, 5)[1];
   EXPECT_NEAR(alpha_prime, 2.0 * x2 - x2_effective, 1e-12);
   const double pair = reduced.emitted_linear.at<cv::Vec3d>(5, 5)[1];
@@ -177,7 +177,7 @@ TEST(LcdDrive, UnreachableReducedFrameIsClampedWithoutTouchingTheNextResidual) {
   EXPECT_EQ(r.drive_codes.at<cv::Vec3w>(0, 0), cv::Vec3w(255, 255, 255));
   const DecodedFrame f = decoder.decode(encoder.encode(white, 2));
   EXPECT_TRUE(test::all_finite(f.emitted_linear));
-  EXPECT_TRUE(test::all_finite(f.stages->residual));
+  EXPECT_TRUE(test::all_finite(f.stages->at(Stage::Residual)));
 }
 
 }  // namespace

@@ -53,18 +53,18 @@ TEST(Motion, WeightFollowsEquations5And6AndVanishesWhereContentMoved) {
   const test::PairOracle o = test::full_frame_oracle(pair.full.codes, link);
   const cv::Mat alpha = test::oracle_upsampled_linear(pair.reduced.codes, o.full_linear.size(), link);
   const cv::Mat c = oracle_contrast(o.low_linear, alpha);
-  EXPECT_LE(max_abs_difference(r.stages->contrast, c), 1e-15);
+  EXPECT_LE(max_abs_difference(r.stages->at(Stage::Contrast), c), 1e-15);
   cv::Mat w(c.size(), CV_64FC1);
   for (int y = 0; y < c.rows; ++y) {
     for (int x = 0; x < c.cols; ++x) w.at<double>(y, x) = std::exp(-config.sensitivity * c.at<double>(y, x));
   }
-  EXPECT_LE(max_abs_difference(r.stages->weight, w), 1e-15);
+  EXPECT_LE(max_abs_difference(r.stages->at(Stage::Weight), w), 1e-15);
 
   // Where the square left (x 8..17) and arrived (x 20..29) the contrast is large and w is tiny; far away it is 1.
-  EXPECT_LT(r.stages->weight.at<double>(15, 12), 0.01);
-  EXPECT_LT(r.stages->weight.at<double>(15, 25), 0.01);
-  EXPECT_EQ(r.stages->weight.at<double>(15, 44), 1.0);
-  EXPECT_EQ(r.stages->weight.at<double>(2, 2), 1.0);
+  EXPECT_LT(r.stages->at(Stage::Weight).at<double>(15, 12), 0.01);
+  EXPECT_LT(r.stages->at(Stage::Weight).at<double>(15, 25), 0.01);
+  EXPECT_EQ(r.stages->at(Stage::Weight).at<double>(15, 44), 1.0);
+  EXPECT_EQ(r.stages->at(Stage::Weight).at<double>(2, 2), 1.0);
   EXPECT_LT(r.stats.mean_motion_weight, 1.0);
 
   // Eq. 4 with the per-pixel w shared by the channels.
@@ -91,8 +91,8 @@ TEST(Motion, ZeroSensitivityAddsTheWholeResidualEverywhere) {
   const MovingPair pair = moving_square(link);
   decoder.decode(pair.full);
   const DecodedFrame r = decoder.decode(pair.reduced);
-  EXPECT_GT(cv::countNonZero(r.stages->contrast), 0);
-  EXPECT_EQ(cv::norm(r.stages->weight, cv::Mat::ones(r.stages->weight.size(), CV_64FC1), cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::countNonZero(r.stages->at(Stage::Contrast)), 0);
+  EXPECT_EQ(cv::norm(r.stages->at(Stage::Weight), cv::Mat::ones(r.stages->at(Stage::Weight).size(), CV_64FC1), cv::NORM_INF), 0.0);
   EXPECT_EQ(r.stats.mean_motion_weight, 1.0);
 }
 
@@ -112,18 +112,18 @@ TEST(Motion, HugeSensitivityIgnoresTheResidualWhereverContrastIsPositive) {
     const MovingPair pair = moving_square(link);
     decoder.decode(pair.full);
     const DecodedFrame r = decoder.decode(pair.reduced);
-    ASSERT_TRUE(test::all_finite(r.stages->weight));
+    ASSERT_TRUE(test::all_finite(r.stages->at(Stage::Weight)));
     ASSERT_TRUE(test::all_finite(r.wanted_linear));
     const test::PairOracle o = test::full_frame_oracle(pair.full.codes, link);
     int moved = 0;
     for (int y = 0; y < r.wanted_linear.rows; ++y) {
       for (int x = 0; x < r.wanted_linear.cols; ++x) {
-        const double c = r.stages->contrast.at<double>(y, x);
-        const double w = r.stages->weight.at<double>(y, x);
+        const double c = r.stages->at(Stage::Contrast).at<double>(y, x);
+        const double w = r.stages->at(Stage::Weight).at<double>(y, x);
         if (c > 0.0) {
           ++moved;
           EXPECT_EQ(w, 0.0);
-          EXPECT_EQ(r.wanted_linear.at<cv::Vec3d>(y, x), r.stages->low_linear.at<cv::Vec3d>(y, x));
+          EXPECT_EQ(r.wanted_linear.at<cv::Vec3d>(y, x), r.stages->at(Stage::Alpha).at<cv::Vec3d>(y, x));
         } else {
           EXPECT_EQ(w, 1.0);  // static pixels keep their residual, no inf * 0
         }
@@ -140,8 +140,8 @@ TEST(Motion, ContrastIsZeroWhereBothFramesAreBlack) {
   const cv::Mat black = cv::Mat::zeros(8, 8, CV_64FC3);
   decoder.decode(encoder.encode(black, 0));
   const DecodedFrame r = decoder.decode(encoder.encode(black, 1));
-  ASSERT_TRUE(test::all_finite(r.stages->contrast));
-  EXPECT_EQ(cv::countNonZero(r.stages->contrast), 0);
+  ASSERT_TRUE(test::all_finite(r.stages->at(Stage::Contrast)));
+  EXPECT_EQ(cv::countNonZero(r.stages->at(Stage::Contrast)), 0);
   EXPECT_EQ(cv::countNonZero(r.wanted_linear.reshape(1)), 0);
 }
 
@@ -152,7 +152,7 @@ TEST(ResidualLifetime, AReducedFrameFirstAddsNothing) {
   const LinkFrame reduced = TrmEncoder(link).encode(image, 1);
   const DecodedFrame r = decoder.decode(reduced);
   EXPECT_FALSE(r.stats.residual_applied);
-  EXPECT_TRUE(r.stages->weight.empty());
+  EXPECT_TRUE(r.stages->at(Stage::Weight).empty());
   const cv::Mat alpha = test::oracle_upsampled_linear(reduced.codes, image.size(), link);
   EXPECT_EQ(max_abs_difference(r.wanted_linear, alpha), 0.0);
 }

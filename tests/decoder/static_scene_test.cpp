@@ -49,17 +49,17 @@ void check_static_pair_is_recovered(const StaticCase& c) {
 
   // Full frame stages against the oracle built from the encoder primitives.
   const test::PairOracle o = test::full_frame_oracle(full.codes, link);
-  EXPECT_EQ(max_abs_difference(f.stages->full_linear, o.full_linear), 0.0);
-  EXPECT_EQ(max_abs_difference(f.stages->low_linear, o.low_linear), 0.0);
-  EXPECT_LE(max_abs_difference(f.stages->beta, o.beta), 1e-15);
+  EXPECT_EQ(max_abs_difference(f.stages->at(Stage::Linear), o.full_linear), 0.0);
+  EXPECT_EQ(max_abs_difference(f.stages->at(Stage::LowPass), o.low_linear), 0.0);
+  EXPECT_LE(max_abs_difference(f.stages->at(Stage::Beta), o.beta), 1e-15);
   EXPECT_LE(max_abs_difference(f.wanted_linear, o.shown), 1e-15);
-  EXPECT_LE(max_abs_difference(f.stages->residual, o.residual), 1e-15);
+  EXPECT_LE(max_abs_difference(f.stages->at(Stage::Residual), o.residual), 1e-15);
 
   // Static: the reduced frame is exactly the d_t the decoder derived, so the motion test sees nothing.
-  EXPECT_EQ(cv::norm(r.stages->low_codes, f.stages->low_codes, cv::NORM_INF), 0.0);
-  EXPECT_EQ(cv::norm(r.stages->low_linear, o.low_linear, cv::NORM_INF), 0.0);  // alpha = L_t bit for bit
-  EXPECT_EQ(cv::countNonZero(r.stages->contrast), 0);
-  EXPECT_EQ(cv::norm(r.stages->weight, cv::Mat::ones(r.stages->weight.size(), CV_64FC1), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(r.stages->at(Stage::Codes), f.stages->at(Stage::Reduced), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(r.stages->at(Stage::Alpha), o.low_linear, cv::NORM_INF), 0.0);  // alpha = L_t bit for bit
+  EXPECT_EQ(cv::countNonZero(r.stages->at(Stage::Contrast)), 0);
+  EXPECT_EQ(cv::norm(r.stages->at(Stage::Weight), cv::Mat::ones(r.stages->at(Stage::Weight).size(), CV_64FC1), cv::NORM_INF), 0.0);
   EXPECT_TRUE(r.stats.residual_applied);
   EXPECT_EQ(r.stats.mean_motion_weight, 1.0);
 
@@ -109,8 +109,8 @@ TEST(StaticScene, SingleBrightPixelOnBlackClipsAndIsStillRecovered) {
   ReferenceDecoder decoder(decoder_config(link));
   const DecodedFrame f = decoder.decode(TrmEncoder(link).encode(image, 0));
   // Maximal overshoot at the pixel, undershoot around it.
-  EXPECT_GT(f.stages->beta.at<cv::Vec3d>(11, 15)[1], 1.5);
-  EXPECT_LT(f.stages->beta.at<cv::Vec3d>(11, 16)[1], 0.0);
+  EXPECT_GT(f.stages->at(Stage::Beta).at<cv::Vec3d>(11, 15)[1], 1.5);
+  EXPECT_LT(f.stages->at(Stage::Beta).at<cv::Vec3d>(11, 16)[1], 0.0);
   EXPECT_GT(f.stats.clipped_fraction, 0.0);
   EXPECT_GT(f.stats.residual_max_abs, 0.5);
 }

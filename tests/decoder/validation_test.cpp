@@ -105,7 +105,7 @@ TEST(DecoderOutput, ReportsTheFullSizeAndKeepsTheParity) {
     EXPECT_EQ(d->emitted_linear.size(), cv::Size(97, 61));
   }
   EXPECT_EQ(r.meta.parity, Parity::Reduced);
-  EXPECT_EQ(r.stages->low_codes.size(), cv::Size(49, 31));  // 97 * 0.5 rounds half up to 49
+  EXPECT_EQ(r.stages->at(Stage::Codes).size(), cv::Size(49, 31));  // 97 * 0.5 rounds half up to 49
 }
 
 TEST(DecoderOutput, StagesAreOnlyRecordedOnRequest) {

@@ -1,11 +1,17 @@
-// Panel models: preset parsing, OLED gamma round trip, the LCD merge (Eq. 7) and its stable inverse.
+// Panel models: preset parsing, OLED gamma round trip, the LCD merge (Eq. 7) and its stable inverse, the panel
+// model's drive and emission against each other and against values worked out by hand, and its JSON.
 #include "trm/panel.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace trm {
 namespace {
@@ -269,6 +275,150 @@ TEST(PerceivedPair, IsTheTimeAverage) {
   EXPECT_EQ(p.at<cv::Vec3d>(1, 2), cv::Vec3d(0.4, 0.2, 1.0));
   EXPECT_THROW(perceived_pair(a, cv::Mat(2, 2, CV_64FC3)), std::invalid_argument);
   EXPECT_THROW(perceived_pair(a, cv::Mat(2, 3, CV_32FC3)), std::invalid_argument);
+}
+
+// The drive of x_t is the inverse of the emission: an OLED emits x again; an LCD pair driven (v_{t-1}, v_t) merges to
+// the average of what the two frames wanted, wherever that is reachable.
+TEST(PanelModel, DriveThenEmissionRoundTrips) {
+  for (const char* spec : {"vive", "rift", "gamma:2.1,2.2,2.3"}) {
+    const Panel oled = parse_panel(spec);
+    EXPECT_FALSE(oled.has_history());
+    for (int channel = 0; channel < 3; ++channel) {
+      for (int i = 0; i <= 64; ++i) {
+        const double x = i / 64.0;
+        const PanelDriveSample s = oled.drive(x, 0.9, 0.9, channel);  // history is ignored
+        EXPECT_TRUE(s.reachable);
+        EXPECT_EQ(s.contributed, x);
+        EXPECT_NEAR(oled.emitted(s.v, 0.3, channel), x, 1e-14) << spec << " x=" << x;
+      }
+    }
+  }
+  for (const char* spec : {"lcd", "lcd:-0.05,0.1,0.5,0.01,2.4"}) {
+    const Panel lcd = parse_panel(spec);
+    EXPECT_TRUE(lcd.has_history());
+    int reachable = 0;
+    for (int i = 0; i <= 16; ++i) {
+      for (int j = 0; j <= 16; ++j) {
+        for (double v_prev : {0.0, 0.3, 0.8, 1.0}) {
+          const double x_t = i / 16.0;
+          const double x_prev = j / 16.0;
+          const PanelDriveSample s = lcd.drive(x_t, x_prev, v_prev, 1);
+          ASSERT_GE(s.v, 0.0);
+          ASSERT_LE(s.v, 1.0);
+          const double pair = lcd.emitted(s.v, v_prev, 1);
+          if (s.reachable) {
+            ++reachable;
+            EXPECT_EQ(s.contributed, x_t);
+            EXPECT_NEAR(pair, 0.5 * (x_t + x_prev), 1e-12) << spec << " " << x_t << " " << x_prev << " " << v_prev;
+          } else {
+            // What the frame really added: the pair averages (x_prev + contributed) / 2.
+            EXPECT_NEAR(0.5 * (x_prev + s.contributed), pair, 1e-15);
+          }
+        }
+      }
+    }
+    EXPECT_GT(reachable, 400) << spec;  // most of the grid is reachable
+  }
+}
+
+// OLED emission is v^gamma_c with the measured Vive gammas (DESIGN §4), and an LCD pair emits M^gamma with M from
+// Eq. 7 worked out by hand.
+TEST(PanelModel, EmissionMatchesAnalyticValues) {
+  const Panel vive = parse_panel("vive");
+  EXPECT_NEAR(vive.emitted(0.25, 0.0, 0), std::exp2(-2 * 2.2912), 1e-16);  // 0.25^2.2912 = 2^-4.5824
+  EXPECT_NEAR(vive.emitted(0.25, 0.0, 1), std::exp2(-2 * 2.2520), 1e-16);
+  EXPECT_NEAR(vive.emitted(0.25, 0.0, 2), std::exp2(-2 * 2.1940), 1e-16);
+  EXPECT_EQ(vive.emitted(1.0, 0.0, 2), 1.0);
+  EXPECT_EQ(vive.emitted(0.0, 1.0, 2), 0.0);
+  EXPECT_EQ(vive.channel_gammas(), (std::array<double, 3>{2.2912, 2.2520, 2.1940}));
+
+  // Defaults p = (-0.1, 0.2, 0.5, 0): M(0.6, 0.2) = -0.1 (0.36 + 0.04) + 0.2 (0.12) + 0.5 (0.8) = 0.384.
+  const Panel lcd = parse_panel("lcd");
+  EXPECT_NEAR(lcd.emitted(0.6, 0.2, 0), std::pow(0.384, 2.2), 1e-15);
+  EXPECT_EQ(lcd.channel_gammas(), (std::array<double, 3>{2.2, 2.2, 2.2}));
+  // p = (-0.05, 0.1, 0.5, 0.01): M(0.3, 0.7) = -0.05 (0.09 + 0.49) + 0.1 (0.21) + 0.5 (1.0) + 0.01 = 0.502.
+  const Panel custom = parse_panel("lcd:-0.05,0.1,0.5,0.01,2.4");
+  EXPECT_NEAR(custom.emitted(0.3, 0.7, 2), std::pow(0.502, 2.4), 1e-15);
+  // Held at one drive: M(v, v) = (2 p1 + p2) v^2 + 2 p3 v + p4 = 0.01 + 0.9 (at v = 0.9, 2 p1 + p2 = 0).
+  EXPECT_NEAR(custom.linear_from_drive(0.9, 0), std::pow(0.91, 2.4), 1e-15);
+
+  // Drive after v_prev = 0.2 towards x_t = 0.3, x_prev = 0.1 on the default panel: m = 0.2^(1/2.2) and
+  // M(v, 0.2) = -0.1 v^2 + 0.54 v + 0.096, so v is the smaller root of -0.1 v^2 + 0.54 v + (0.096 - m) = 0.
+  const double m = std::pow(0.2, 1.0 / 2.2);
+  const double v = (0.54 - std::sqrt(0.54 * 0.54 + 0.4 * (0.096 - m))) / 0.2;
+  const PanelDriveSample s = lcd.drive(0.3, 0.1, 0.2, 0);
+  EXPECT_TRUE(s.reachable);
+  EXPECT_NEAR(s.target, m, 1e-15);
+  EXPECT_NEAR(s.v, v, 1e-14);
+}
+
+TEST(PanelModel, EmissionTableIsTheEmissionOfEveryCode) {
+  for (const char* spec : {"rift", "lcd:-0.05,0.1,0.5,0.01,2.4"}) {
+    const Panel panel = parse_panel(spec);
+    const PanelEmission table(panel, 8);
+    for (int code : {0, 1, 77, 254, 255}) {
+      for (int previous : {0, 128, 255}) {
+        for (int channel = 0; channel < 3; ++channel) {
+          EXPECT_EQ(table(static_cast<std::uint16_t>(code), static_cast<std::uint16_t>(previous), channel),
+                    panel.emitted(code / 255.0, previous / 255.0, channel));
+        }
+      }
+    }
+  }
+}
+
+TEST(PanelModel, PerceivedPairAveragesOledAndTakesTheLcdMerge) {
+  const cv::Mat a(1, 2, CV_64FC3, cv::Scalar(0.2, 0.4, 1.0));
+  const cv::Mat b(1, 2, CV_64FC3, cv::Scalar(0.6, 0.0, 1.0));
+  EXPECT_EQ(parse_panel("vive").perceived_pair(a, b).at<cv::Vec3d>(0, 1), cv::Vec3d(0.4, 0.2, 1.0));
+  EXPECT_EQ(parse_panel("lcd").perceived_pair(a, b).at<cv::Vec3d>(0, 1), cv::Vec3d(0.6, 0.0, 1.0));
+}
+
+TEST(PanelJson, RoundTripsEveryKind) {
+  for (const char* spec : {"vive", "rift", "generic", "gamma:2.4", "gamma:2.1,2.2,2.3", "lcd",
+                           "lcd:-0.05,0.1,0.5,0.01,2.4", "lcd:0,0,0.5,0,1.8"}) {
+    const Panel panel = parse_panel(spec);
+    const nlohmann::json j = panel;
+    EXPECT_EQ(j.at("name"), spec);
+    EXPECT_EQ(j.at("kind"), panel.has_history() ? "lcd" : "oled");
+    EXPECT_EQ(j.get<Panel>(), panel) << j.dump();
+    // Through text too (numbers written to round-trip), and through the ordered flavour the reports use.
+    EXPECT_EQ(nlohmann::json::parse(j.dump()).get<Panel>(), panel);
+    const nlohmann::ordered_json ordered = panel;
+    EXPECT_EQ(nlohmann::ordered_json::parse(ordered.dump()).get<Panel>(), panel);
+  }
+  EXPECT_EQ(nlohmann::json(parse_panel("vive")).dump(),
+            R"({"duty":0.2,"gamma":[2.2912,2.252,2.194],"kind":"oled","name":"vive"})");
+}
+
+TEST(PanelJson, RefusesBadJsonWithAClearMessage) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"([1, 2])", "expected an object"},
+      {R"({"name": "x", "gamma": [2.2, 2.2, 2.2], "duty": 0.2})", "missing \"kind\""},
+      {R"({"kind": "crt", "name": "x"})", "\"kind\" must be \"oled\" or \"lcd\""},
+      {R"({"kind": "oled", "gamma": [2.2, 2.2, 2.2], "duty": 0.2})", "missing \"name\""},
+      {R"({"kind": "oled", "name": 3, "gamma": [2.2, 2.2, 2.2], "duty": 0.2})", "\"name\" must be a string"},
+      {R"({"kind": "oled", "name": "x", "gamma": [2.2, 2.2], "duty": 0.2})", "must be 3 numbers"},
+      {R"({"kind": "oled", "name": "x", "gamma": [2.2, "a", 2.2], "duty": 0.2})", "must be 3 numbers"},
+      {R"({"kind": "oled", "name": "x", "gamma": [2.2, 2.2, 2.2]})", "missing \"duty\""},
+      {R"({"kind": "oled", "name": "x", "gamma": [2.2, 9, 2.2], "duty": 0.2})", "OLED gamma 9 is outside"},
+      {R"({"kind": "oled", "name": "x", "gamma": [2.2, 2.2, 2.2], "duty": 0})", "OLED duty must be in (0, 1]"},
+      {R"({"kind": "lcd", "name": "x", "p1": -0.1, "p2": 0.2, "p3": 0.5, "gamma": 2.2})", "missing \"p4\""},
+      {R"({"kind": "lcd", "name": "x", "p1": -0.1, "p2": 0.2, "p3": "0.5", "p4": 0, "gamma": 2.2})",
+       "\"p3\" must be a number"},
+      {R"({"kind": "lcd", "name": "x", "p1": -1, "p2": 0, "p3": 0.5, "p4": 0, "gamma": 2.2})",
+       "must be increasing in v_t"},
+  };
+  for (const auto& [text, fragment] : cases) {
+    try {
+      (void)nlohmann::json::parse(text).get<Panel>();
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const std::invalid_argument& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("panel JSON: ", 0), 0u) << message;
+      EXPECT_NE(message.find(fragment), std::string::npos) << text << " -> " << message;
+    }
+  }
 }
 
 }  // namespace

@@ -44,7 +44,7 @@ void register_hw_report(CLI::App& app, Action& action) {
         dir.commit();
       }
       if (!json->empty()) io::write_file_atomically(*json, text);
-      std::cout << "trm hw-report: " << options->panel << ", r = " << options->encoder.reduction << " ("
+      std::cout << "trm hw-report: " << options->panel.name << ", r = " << options->encoder.reduction << " ("
                 << to_string(options->encoder.resample_space) << " resample space), "
                 << options->encoder.bits << "-bit link, " << options->output_bits << "-bit drive, residual "
                 << config.residual.to_string() << "\n"

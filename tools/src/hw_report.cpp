@@ -12,7 +12,7 @@ FixedDecoderConfig fixed_config_of(const PipelineOptions& options) {
   FixedDecoderConfig config;
   config.decoder.link = options.encoder;
   config.decoder.sensitivity = options.sensitivity;
-  config.decoder.panel = parse_panel(options.panel);
+  config.decoder.panel = options.panel;
   config.decoder.output_bits = options.output_bits;
   config.decoder.lcd_history = options.lcd_history;
   config.skip_unneeded = !options.no_skip;

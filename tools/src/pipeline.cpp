@@ -85,7 +85,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 double run_bytes_per_pixel(const PipelineOptions& options) {
-  const bool lcd = parse_panel(options.panel).kind == PanelKind::Lcd;
+  const bool lcd = options.panel.has_history();
   return (lcd ? kRunBytesPerPixelLcd : kRunBytesPerPixelOled) * (options.encoder.stereo ? kRunStereoFactor : 1.0);
 }
 
@@ -175,8 +175,10 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--output-bits", output_bits, "Drive code bits only (overrides --bits)");
   cmd.add_flag("--stereo", encoder.stereo, "Two eyes off-phase: every link frame carries one full and one reduced view");
   cmd.add_option("--sensitivity,-s", sensitivity, "Motion sensitivity s in w = exp(-s c)")->capture_default_str();
-  cmd.add_option("--panel", panel, "vive | rift | generic | gamma:G | gamma:GR,GG,GB | lcd | lcd:p1,p2,p3,p4,gamma")
-      ->capture_default_str();
+  cmd.add_option_function<std::string>(
+         "--panel", [this](const std::string& spec) { panel = parse_panel(spec); },
+         "vive | rift | generic | gamma:G | gamma:GR,GG,GB | lcd | lcd:p1,p2,p3,p4,gamma")
+      ->default_str(panel.name);
   cmd.add_option_function<std::string>(
       "--lcd-history",
       [this](const std::string& s) {
@@ -336,7 +338,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   // LCD codes compared free-running drift apart by the design's neutral mode (see adopt_panel_history); the
   // synchronised comparison is the criterion, the free-running one is reported beside it.
   std::unique_ptr<MethodDisplay> free_running;
-  if (compare && setup.decoder.decoder.panel.kind == PanelKind::Lcd) {
+  if (compare && setup.decoder.decoder.panel.has_history()) {
     free_running = method.method->make_display(reference_setup);
   }
   auto* const synchronised_reference =

@@ -30,7 +30,7 @@ struct PipelineOptions {
   std::uint64_t seed = 1;
   EncoderConfig encoder;
   double sensitivity = 10.0;
-  std::string panel = "vive";
+  Panel panel = parse_panel("vive");  // --panel, parsed once as it is read
   int output_bits = 8;
   std::string method = "trm";         // display method (trm/display_method.hpp): NAME or NAME:OPTION
   std::string impl = "reference";     // reference | fixed (streaming, the hardware model) | fixed-frame

@@ -97,7 +97,7 @@ void JsonLinesWriter::close() { file_.commit(); }
 
 RunRecorder::RunRecorder(const PipelineOptions& options, const std::filesystem::path& directory)
     : options_(options),
-      panel_(parse_panel(options.panel)),
+      panel_(options.panel),
       view_records_(directory / "views.jsonl"),
       pair_records_(directory / "pairs.jsonl") {}
 
@@ -150,7 +150,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     rec["mean_motion_weight"] = d.stats.mean_motion_weight;
     rec["dropped_sum"] = d.stats.dropped_sum;
   }
-  if (panel_.kind == PanelKind::Lcd) rec["lcd_unreachable_fraction"] = d.stats.lcd_unreachable_fraction;
+  if (panel_.has_history()) rec["lcd_unreachable_fraction"] = d.stats.lcd_unreachable_fraction;
   if (view.fixed_counts) {
     const FixedStageCounts& c = *view.fixed_counts;
     rec["fixed_point_events"] = events_json(c);
@@ -162,14 +162,12 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   if (view.reference) {
     const auto [identical, max_lsb] = vs_reference_.add(d.drive_codes, view.reference->drive_codes);
     rec["vs_reference"] = {{"identical_fraction", identical}, {"max_lsb", max_lsb}};
-    if (panel_.kind == PanelKind::Lcd) rec["vs_reference"]["panel_history"] = "synchronised";
+    if (panel_.has_history()) rec["vs_reference"]["panel_history"] = "synchronised";
   }
   if (view.free_running_reference) {
     const auto [identical, max_lsb] = vs_free_running_.add(d.drive_codes, view.free_running_reference->drive_codes);
-    cv::Mat merged;
-    cv::Mat merged_reference;
-    cv::pow(d.emitted_linear, 1.0 / panel_.lcd.gamma, merged);
-    cv::pow(view.free_running_reference->emitted_linear, 1.0 / panel_.lcd.gamma, merged_reference);
+    const cv::Mat merged = panel_.lcd.merged_of_emission(d.emitted_linear);
+    const cv::Mat merged_reference = panel_.lcd.merged_of_emission(view.free_running_reference->emitted_linear);
     const double merge_codes =
         cv::norm(merged, merged_reference, cv::NORM_INF) * ((1 << options_.output_bits) - 1);
     vs_free_running_.max_merge_codes = std::max(vs_free_running_.max_merge_codes, merge_codes);
@@ -185,9 +183,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   EyeHistory& eye = eyes_[meta.eye];
   cv::Mat perceived;
   if (meta.index % 2 == 1 && eye.index == meta.index - 1) {
-    // OLED: Talbot-Plateau average of the two frames' emission. LCD: the panel model's emission of frame t
-    // is already the merged value of (v_t, v_{t-1}) over the pair.
-    perceived = panel_.kind == PanelKind::Lcd ? d.emitted_linear.clone() : perceived_pair(eye.emitted, d.emitted_linear);
+    perceived = panel_.perceived_pair(eye.emitted, d.emitted_linear);
     last_reference_pair_ = perceived_pair(eye.reference, reference);
     const double psnr = psnr_encoded(perceived, last_reference_pair_);
     const double max_abs = cv::norm(perceived, last_reference_pair_, cv::NORM_INF);
@@ -251,7 +247,7 @@ Json RunRecorder::report(double wall_seconds) const {
     s["vs_reference"] = {{"codes_compared", vs_reference_.compared},
                          {"identical_fraction", vs_reference_.identical_fraction()},
                          {"max_lsb", vs_reference_.max_lsb}};
-    if (panel_.kind == PanelKind::Lcd) s["vs_reference"]["panel_history"] = "synchronised";
+    if (panel_.has_history()) s["vs_reference"]["panel_history"] = "synchronised";
   }
   if (vs_free_running_.compared > 0) {
     s["vs_free_running_reference"] = {{"codes_compared", vs_free_running_.compared},
@@ -305,7 +301,7 @@ std::string RunRecorder::summary_table() const {
     row(("decoder " + options_.method_impl() + " vs reference").c_str(),
         fmt("%.4f %% of codes identical", 100.0 * vs_reference_.identical_fraction()) +
             fmt(", max %.0f LSB", vs_reference_.max_lsb) +
-            (panel_.kind == PanelKind::Lcd ? " (panel history synchronised)" : ""));
+            (panel_.has_history() ? " (panel history synchronised)" : ""));
   }
   if (vs_free_running_.compared > 0) {
     row("  free-running (own LCD history)",

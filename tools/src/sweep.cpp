@@ -127,9 +127,9 @@ std::string knob_list() {
 }
 
 // Why a knob does nothing for this panel and resample space, or empty when it applies.
-std::string not_applicable(const SweepKnob& knob, PanelKind kind, ResampleSpace space) {
-  if (kind == PanelKind::Lcd && !knob.lcd) return "not used with the LCD panel";
-  if (kind == PanelKind::Oled && !knob.oled) return "used with the LCD panel only";
+std::string not_applicable(const SweepKnob& knob, const Panel& panel, ResampleSpace space) {
+  if (panel.has_history() && !knob.lcd) return "not used with the LCD panel";
+  if (!panel.has_history() && !knob.oled) return "used with the LCD panel only";
   if (knob.linear_space_only && space != ResampleSpace::Linear) return "used with --resample-space linear only";
   return "";
 }
@@ -326,7 +326,7 @@ std::string header_line(const SweepResult& r) {
   std::ostringstream s;
   const auto& o = r.options.pipeline;
   s << source_text(r.options) << " " << r.size.width << "x" << r.size.height << " (reduced " << r.reduced.width << "x"
-    << r.reduced.height << "), " << r.views << " views, r = " << o.encoder.reduction << ", " << o.panel << ", "
+    << r.reduced.height << "), " << r.views << " views, r = " << o.encoder.reduction << ", " << o.panel.name << ", "
     << o.encoder.bits << "-bit link, " << o.output_bits << "-bit drive";
   return s.str();
 }
@@ -542,7 +542,7 @@ const SweepPoint* SweepKnobResult::cheapest_meeting() const {
 SweepResult run_sweep(const SweepOptions& options,
                       const std::function<void(std::int64_t done, std::int64_t total)>& progress) {
   options.validate();
-  const Panel panel = parse_panel(options.pipeline.panel);
+  const Panel& panel = options.pipeline.panel;
   const FixedDecoderConfig base = fixed_config_of(options.pipeline);
   (void)make_decoder("fixed", base);  // an unusable base configuration fails the whole sweep, with its message
 
@@ -558,7 +558,7 @@ SweepResult run_sweep(const SweepOptions& options,
   std::vector<std::vector<int>> values(chosen.size());
   std::int64_t decodes = 1;  // the base point
   for (std::size_t i = 0; i < chosen.size(); ++i) {
-    if (!not_applicable(*chosen[i], panel.kind, options.pipeline.encoder.resample_space).empty()) continue;
+    if (!not_applicable(*chosen[i], panel, options.pipeline.encoder.resample_space).empty()) continue;
     std::set<int> set(options.values.empty() ? chosen[i]->values.begin() : options.values.begin(),
                       options.values.empty() ? chosen[i]->values.end() : options.values.end());
     set.insert(chosen[i]->get(base));
@@ -597,7 +597,7 @@ SweepResult run_sweep(const SweepOptions& options,
     SweepKnobResult kr;
     kr.knob = &knob;
     kr.default_value = knob.get(base);
-    kr.skipped = not_applicable(knob, panel.kind, options.pipeline.encoder.resample_space);
+    kr.skipped = not_applicable(knob, panel, options.pipeline.encoder.resample_space);
     if (!kr.skipped.empty()) {
       result.knobs.push_back(std::move(kr));
       continue;

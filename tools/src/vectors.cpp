@@ -47,7 +47,7 @@ std::string readme_text(const PipelineOptions& options, const FixedDecoderConfig
   std::ostringstream s;
   s << "# Golden vectors of the fixed-point TRM decoder\n\n"
     << "Scene `" << options.scene << "`, " << options.width << "x" << options.height << ", r = "
-    << options.encoder.reduction << ", " << options.encoder.bits << "-bit link, panel `" << options.panel << "`, "
+    << options.encoder.reduction << ", " << options.encoder.bits << "-bit link, panel `" << options.panel.name << "`, "
     << options.output_bits << "-bit drive, s = " << options.sensitivity << ", residual "
     << config.residual.to_string() << ", D and U in the " << to_string(options.encoder.resample_space)
     << " resample space.\n"
@@ -153,7 +153,7 @@ std::string golden_vectors_text() {
     for (const char* scene : {"discs", "checker", "flash"}) {
       PipelineOptions options;
       options.scene = scene;
-      options.panel = panel;
+      options.panel = parse_panel(panel);
       options.width = 24;
       options.height = 16;
       options.frames = 4;

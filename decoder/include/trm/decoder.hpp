@@ -8,6 +8,7 @@
 #include "trm/frame.hpp"
 #include "trm/panel.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -53,22 +54,42 @@ struct FrameStats {
   bool frame_lost = false;             // nothing of this view arrived: the previous output was held
 };
 
-// Per-stage intermediates of one decoded frame (DESIGN §4 notation). Matrices that do not apply to the frame
-// (or to the panel) are left empty. Full-size values are CV_64FC3 unless noted.
+// The stages of one decoded view in DESIGN §4 notation: the one vocabulary of every decoder's stage record (the
+// reference's DecodeStages in double precision, the fixed-point decoders' integer FixedStageTaps). Which stages a
+// record holds depends on the frame kind and the panel; each stage means the same thing in both.
+enum class Stage {
+  Codes,              // received link codes (full size for full frames, reduced size for reduced frames)
+  Linear,             // full: I = lin(E_t)
+  Reduced,            // full: d_t = Q_b(D(E_t)) as the frame store holds it, link codes (exact ties rounded up;
+                      // linear space: Q_b(enc(D(lin(E_t)))))
+  LowPass,            // full: L = lin(U(d_t)) (linear space: U(lin(d_t)))
+  Beta,               // full: beta = 2 I - L before clamping (Eq. 2)
+  Shown,              // full: clamp(beta, 0, 1)
+  Residual,           // full: rho after this frame, LCD shortfall included (fixed point: in the residual store
+                      // format); reduced: the rho consumed
+  Alpha,              // reduced: alpha = lin(U(i)) (Eq. 1)
+  PreviousLowPass,    // reduced with residual: L_{t-1} = lin(U(d_{t-1})) for the motion test
+  Contrast,           // reduced with residual: motion contrast c (Eq. 5), one value per pixel
+  Weight,             // reduced with residual: w = exp(-s c) (Eq. 6), one value per pixel
+  AlphaPrime,         // reduced: alpha' = clamp(alpha + w rho, 0, 1) (Eq. 4; clamp(alpha) without a residual)
+  Drive,              // drive codes (output_bits)
+  AlphaUnclamped,     // reduced with residual: alpha + w rho before clamping
+  LcdTarget,          // LCD: the pair target m = ((x_t + x_{t-1}) / 2)^(1/gamma)
+  LcdPreviousDrive,   // LCD: v_{t-1} the merge was solved against (the quantised drive, as a value)
+  LcdPreviousLinear,  // LCD: x_{t-1} the target was built on (see LcdHistory)
+  LcdUnreachable,     // LCD: 255 where M(v, v_{t-1}) = m had no root in [0, 1] (CV_8UC3)
+};
+inline constexpr int kStageCount = 18;
+
+// The short, file-friendly name of a stage (test vector files, reports): "codes", "I", "d", "L", "beta", ...
+const char* stage_name(Stage stage);
+
+// Per-stage intermediates of one decoded frame in double precision, by Stage. Matrices that do not apply to the
+// frame (or to the panel) are left empty. Full-size values are CV_64FC3 unless noted above; codes CV_16UC3.
 struct DecodeStages {
-  cv::Mat low_codes;            // full: d_t = Q_b(D(E_t)); reduced: i_t as received (CV_16UC3, reduced size)
-  cv::Mat low_linear;           // full: L_t = lin(U(d_t)); reduced: alpha = lin(U(i_t))
-  cv::Mat full_linear;          // full: I_t = lin(E_t)
-  cv::Mat beta;                 // full: beta = 2 I_t - L_t before clamping (Eq. 2)
-  cv::Mat residual;             // full: rho_t after this frame, LCD shortfall included; reduced: the rho consumed
-  cv::Mat previous_low_linear;  // reduced with residual: L_prev = lin(U(d_{t-1}))
-  cv::Mat contrast;             // reduced with residual: c (Eq. 5), CV_64FC1
-  cv::Mat weight;               // reduced with residual: w = exp(-s c) (Eq. 6), CV_64FC1
-  cv::Mat alpha_unclamped;      // reduced with residual: alpha + w rho (Eq. 4) before clamping
-  cv::Mat lcd_target;           // LCD: target merged value m = ((x_t + x_{t-1}) / 2)^(1/gamma)
-  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} the merge was solved against (quantised drive, as a value)
-  cv::Mat lcd_previous_linear;  // LCD: x_{t-1} the target was built on (see EyeState::previous_wanted)
-  cv::Mat lcd_unreachable;      // LCD: 255 where M(v, v_{t-1}) = m had no root in [0, 1] (CV_8UC3)
+  std::array<cv::Mat, kStageCount> planes;
+  cv::Mat& at(Stage stage) { return planes[static_cast<std::size_t>(stage)]; }
+  const cv::Mat& at(Stage stage) const { return planes[static_cast<std::size_t>(stage)]; }
 };
 
 struct DecodedFrame {

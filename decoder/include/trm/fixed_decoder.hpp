@@ -196,7 +196,7 @@ struct FixedRomReport {
   std::int64_t total_bits() const { return static_cast<std::int64_t>(count) * entries * word_bits; }
 };
 
-// Arithmetic of one stage, as the shared kernels (decoder/src/fixed_kernels.cpp) perform it: operators per
+// Arithmetic of one stage, as the shared kernels (decoder/src/fixed_stages.cpp) perform it: operators per
 // evaluation, and evaluations per frame of the given kind. Comparators include clamps and binary-search steps;
 // rounding additions (of the half LSB before a shift) are counted as adders.
 struct FixedArithmeticReport {
@@ -228,30 +228,13 @@ struct FixedStreamingReport {
   std::string concealment;
 };
 
-// The integer planes of every stage of one decoded frame, for test vectors (FixedFrameDecoder::decode with taps).
-// Values are the raw integers of the stage's format, row-major with channels interleaved (R G B) where
-// channels == 3; motion contrast and weight are one value per pixel.
-enum class FixedStage {
-  Codes,           // received link codes (full size for full frames, reduced size for reduced frames)
-  Linear,          // full: I = lin(E_t)
-  Reduced,         // full: d_t = Q_b(D(E_t)) as the frame store holds it, link codes (exact ties rounded up;
-                   // linear space: Q_b(enc(D(lin(E_t)))))
-  LowPass,         // full: L = lin(U(d_t)) (linear space: U(lin(d_t)))
-  Beta,            // full: beta = 2 I - L
-  Shown,           // full: clamp(beta, 0, 1)
-  Residual,        // full: rho (plus any LCD shortfall) in the residual store format
-  Alpha,           // reduced: alpha = lin(U(i))
-  PreviousLowPass, // reduced: L_{t-1} = lin(U(d_{t-1})) for the motion test
-  Contrast,        // reduced: motion contrast c (per pixel)
-  Weight,          // reduced: w = exp(-s c) (per pixel)
-  AlphaPrime,      // reduced: alpha' = clamp(alpha + w rho, 0, 1) (clamp(alpha) without a residual)
-  Drive,           // drive codes (output_bits)
-};
-inline constexpr int kFixedStageCount = 13;
-
+// The integer planes of every stage of one decoded frame, for test vectors (FixedFrameDecoder::decode with taps),
+// by Stage (the stages up to Drive; the LCD and unclamped-alpha stages are not tapped). Values are the raw integers
+// of the stage's format, row-major with channels interleaved (R G B) where channels == 3; motion contrast and weight
+// are one value per pixel.
 struct FixedStagePlane {
   bool present = false;
-  std::string name;      // short file-friendly name, e.g. "beta"
+  std::string name;      // stage_name() of its stage, e.g. "beta"
   std::string format;    // e.g. "sQ3.24"
   int bits = 0;          // word width including the sign bit
   bool is_signed = false;
@@ -261,13 +244,15 @@ struct FixedStagePlane {
 };
 
 struct FixedStageTaps {
-  std::array<FixedStagePlane, kFixedStageCount> planes;
-  FixedStagePlane& operator[](FixedStage s) { return planes[static_cast<std::size_t>(s)]; }
-  const FixedStagePlane& operator[](FixedStage s) const { return planes[static_cast<std::size_t>(s)]; }
+  std::array<FixedStagePlane, kStageCount> planes;
+  FixedStagePlane& operator[](Stage s) { return planes[static_cast<std::size_t>(s)]; }
+  const FixedStagePlane& operator[](Stage s) const { return planes[static_cast<std::size_t>(s)]; }
 };
 
 namespace fixed_detail {
 class FixedDecoderCore;
+}
+namespace detail {
 struct Concealment;
 }
 
@@ -296,7 +281,7 @@ class FixedFrameDecoder : public HeadsetDecoder {
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps, const fixed_detail::Concealment* lost);
+  DecodedFrame decode_impl(const LinkFrame& frame, FixedStageTaps* taps, const detail::Concealment* lost);
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
@@ -325,7 +310,7 @@ class FixedStreamingDecoder : public HeadsetDecoder {
 
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, const fixed_detail::Concealment* lost);
+  DecodedFrame decode_impl(const LinkFrame& frame, const detail::Concealment* lost);
 };
 
 }  // namespace trm

@@ -55,6 +55,7 @@ class ReferenceDecoder : public HeadsetDecoder {
   DecodedFrame decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
 
   DecoderConfig config_;
+  PanelEmission emission_;  // the light of every drive code (after every previous code, with history)
   std::map<int, EyeState> eyes_;
 };
 

@@ -10,7 +10,8 @@
 
 namespace trm::methods {
 
-PanelShow::PanelShow(const DecoderConfig& config) : config_(config) { config_.validate(); }
+PanelShow::PanelShow(const DecoderConfig& config)
+    : config_(config), emission_((config_.validate(), config_.panel), config_.output_bits) {}
 
 DecodedFrame PanelShow::show(const FrameMeta& meta, const cv::Mat& wanted) {
   cv::Mat drive(wanted.size(), CV_64FC3);
@@ -69,9 +70,7 @@ DecodedFrame PanelShow::emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat driv
   out.wanted_linear = std::move(wanted);
   out.drive = std::move(drive);
   out.drive_codes = std::move(codes);
-  const double top = std::ldexp(1.0, config_.output_bits) - 1.0;
-  const Panel& panel = config_.panel;
-  // An LCD merges frame t with the codes of frame t-1 (the first frame of an eye as if held).
+  // A panel with history merges frame t with the codes of frame t-1 (the first frame of an eye as if held).
   const auto last = last_.find(meta.eye);
   const bool have_previous = last != last_.end() && last->second.drive_codes.size() == out.drive_codes.size();
   const cv::Mat& previous = have_previous ? last->second.drive_codes : out.drive_codes;
@@ -81,12 +80,7 @@ DecodedFrame PanelShow::emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat driv
     const auto* p_row = previous.ptr<cv::Vec3w>(y);
     auto* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
     for (int x = 0; x < out.drive_codes.cols; ++x) {
-      for (int ch = 0; ch < 3; ++ch) {
-        const double v = q_row[x][ch] / top;
-        e_row[x][ch] = panel.kind == PanelKind::Lcd
-                           ? std::pow(std::max(panel.lcd.merge(v, p_row[x][ch] / top), 0.0), panel.lcd.gamma)
-                           : panel.linear_from_drive(v, ch);
-      }
+      for (int ch = 0; ch < 3; ++ch) e_row[x][ch] = emission_(q_row[x][ch], p_row[x][ch], ch);
     }
   }
   last_[meta.eye] = out;

@@ -34,6 +34,7 @@ class PanelShow {
  private:
   DecodedFrame emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat drive, cv::Mat codes);
   DecoderConfig config_;
+  PanelEmission emission_;
   std::map<int, DecodedFrame> last_;  // per eye
 };
 

@@ -203,6 +203,17 @@ constexpr int128 convert(int128 raw_in, int in_frac_bits, const Target& t, Satur
 }
 
 }  // namespace detail
+
+// raw * 2^-shift rounded to an integer with q, without an overflow stage: for an accumulator brought back onto its
+// result's LSB where the result format holds every value by construction. It is the quantisation step of every
+// conversion above, so arithmetic that rounds with it rounds exactly as the Fixed types and quantise_raw do.
+constexpr detail::int128 rounded_shift(detail::int128 raw, int shift, Quant q) {
+  return detail::quantise_only(raw, shift, 0, q).raw;
+}
+constexpr std::int64_t rounded_shift(std::int64_t raw, int shift, Quant q) {
+  return static_cast<std::int64_t>(rounded_shift(static_cast<detail::int128>(raw), shift, q));
+}
+
 }  // namespace trm::fx
 
 namespace trm::fx::detail {

@@ -1,17 +1,44 @@
 // Panel models (DESIGN §4 "Panel drive", paper Sec. 4.4): OLED per-channel gamma and the LCD temporal
 // merge model (Eq. 7) with its numerically stable inverse. Double precision (reference).
+//
+// Each panel kind owns its parameters, their parsing and validation, the drive (inverse: linear light -> drive value,
+// given the panel's history) and the emission (forward: drive value -> linear light, given the history), and the
+// sample functions the fixed-point ROMs tabulate. Panel is the model every decoder, report and tool asks: a closed
+// variant over the two kinds rather than a virtual interface, because configurations hold it by value (they are
+// copied per decoder and sweep point, compared, and written to JSON) and the fixed-point decoder builds different
+// ROMs and frame stores per kind at construction, so a new kind needs new hardware anyway, not just a new subclass.
 #pragma once
 
+#include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace trm {
+
+// What a panel drive of one channel sample gives (Panel::drive).
+struct PanelDriveSample {
+  double v = 0.0;            // the drive value in [0, 1], before output quantisation
+  double target = 0.0;       // LCD: the merged value m the pair must reach; OLED: v
+  bool reachable = true;     // LCD: M(v, v_prev) = m had a root in [0, 1]; OLED: always
+  double contributed = 0.0;  // what this frame adds to the pair in linear light: x_t, or where unreachable
+                             // x_t_eff = 2 M(v, v_prev)^gamma - x_{t-1}
+};
 
 struct OledPanel {
   std::array<double, 3> gamma{2.2, 2.2, 2.2};  // R, G, B: I = v^gamma
   double duty = 0.2;                           // persistence: fraction of the frame the pixel emits
+
+  // I = v^gamma_c.
+  double emitted(double v, int channel) const;
+  // v = clamp(x, 0, 1)^(1/gamma_c).
+  double drive(double x, int channel) const;
+  // Throws std::invalid_argument with `what` and the broken rule (see validate_panel).
+  void validate(const std::string& what) const;
+  friend bool operator==(const OledPanel&, const OledPanel&) = default;
 };
 
 // LCD merge (Eq. 7): M(vt, vp) = p1 (vt^2 + vp^2) + p2 vt vp + p3 (vt + vp) + p4, luminance M^gamma.
@@ -28,6 +55,24 @@ struct LcdPanel {
     bool reachable = true;
   };
   Solution solve(double m, double v_prev) const;
+
+  // The light of a merged value: max(M, 0)^gamma (negative merged values emit no light).
+  double luminance(double merged) const;
+  // Emission of drive v_t after v_prev: the pair's merged light M(v_t, v_prev)^gamma, which is already the time
+  // average of the two frames.
+  double emitted(double v_t, double v_prev) const { return luminance(merge(v_t, v_prev)); }
+  // The pair target m = ((x_t + x_{t-1}) / 2)^(1/gamma), the average clamped at 0.
+  double target(double x_t, double x_prev) const;
+  // The drive of x_t after a frame that contributed x_prev and was driven at v_prev (DESIGN §4 inverse).
+  PanelDriveSample drive(double x_t, double x_prev, double v_prev) const;
+  // The merge of a pixel held at one drive, M(v, v), as a merge in v_t alone: p1' = 2 p1 + p2, p2' = 0,
+  // p3' = 2 p3, p4' = p4 at v_prev = 0 (so the stable solver applies to it).
+  LcdPanel held() const;
+  // The merged values M of emitted light M^gamma (undoes luminance() where M >= 0).
+  cv::Mat merged_of_emission(const cv::Mat& emitted) const;
+  // Throws std::invalid_argument with `what` and the broken rule (see validate_panel).
+  void validate(const std::string& what) const;
+  friend bool operator==(const LcdPanel&, const LcdPanel&) = default;
 };
 
 enum class PanelKind { Oled, Lcd };
@@ -38,9 +83,45 @@ struct Panel {
   OledPanel oled;
   LcdPanel lcd;
 
-  // OLED: I = v^gamma_c. LCD (one frame held, as if v_prev = v): M(v, v)^gamma = v^gamma.
+  // The emission depends on the previous frame's drive (LCD): the decoder keeps v_{t-1} and x_{t-1} frame stores.
+  bool has_history() const { return kind == PanelKind::Lcd; }
+  // The exponent of each channel's emission (OLED gamma_c; LCD one gamma for all): what the fixed-point drive
+  // thresholds and inverse-gamma LUTs tabulate.
+  std::array<double, 3> channel_gammas() const;
+
+  // The drive of x_t (channel sample) given the history: x_prev, what the previous frame contributed, and v_prev,
+  // its drive value. Panels without history ignore both.
+  PanelDriveSample drive(double x_t, double x_prev, double v_prev, int channel) const;
+  // The light drive v emits after drive v_prev (ignored without history).
+  double emitted(double v, double v_prev, int channel) const;
+  // A pixel held at one drive (no history, or the same frame before): OLED v^gamma_c, LCD M(v, v)^gamma.
   double linear_from_drive(double v, int channel) const;
+  // Its inverse: the drive that holds x (clamped to [0, 1]).
   double drive_from_linear(double x, int channel) const;
+  // What the eye sees over a frame pair from the emission of its two frames: the Talbot-Plateau average, or, for a
+  // panel whose emission already merges the pair (LCD), the second frame's emission.
+  cv::Mat perceived_pair(const cv::Mat& first_emitted, const cv::Mat& second_emitted) const;
+
+  // Throws std::invalid_argument with `what` and the broken rule (see validate_panel).
+  void validate(const std::string& what) const;
+  // Same kind, name and parameters of that kind (the other kind's parameters are not part of the panel).
+  friend bool operator==(const Panel& a, const Panel& b);
+};
+
+// The light of every drive code after every previous code at one output depth (previous codes only for a panel with
+// history): the emission both decoders report for their quantised drive, tabulated once instead of a pow per sample
+// (the same doubles as Panel::emitted of code / (2^bits - 1)).
+class PanelEmission {
+ public:
+  PanelEmission(const Panel& panel, int output_bits);
+  double operator()(std::uint16_t code, std::uint16_t previous_code, int channel) const {
+    return history_ ? table_[code * codes_ + previous_code] : table_[static_cast<std::size_t>(channel) * codes_ + code];
+  }
+
+ private:
+  std::size_t codes_ = 0;
+  bool history_ = false;
+  std::vector<double> table_;  // with history [code][previous] (one for every channel); else [channel][code]
 };
 
 // The panels every decoder accepts. Display gammas are measured near 2.2 (1.8 to 2.6); [0.5, 4] leaves room for
@@ -62,6 +143,16 @@ void validate_panel(const Panel& panel, const std::string& what);
 // Throws std::invalid_argument with the list of accepted forms, for a malformed spec and for a panel that breaks
 // validate_panel's rules.
 Panel parse_panel(const std::string& spec);
+
+// The panel as JSON, every parameter of its kind: {"kind": "oled", "name", "gamma": [R, G, B], "duty"} or
+// {"kind": "lcd", "name", "p1", "p2", "p3", "p4", "gamma"}. The one writer and the one reader of a panel, for both
+// JSON flavours the reports use (one body each).
+void to_json(nlohmann::json& out, const Panel& panel);
+void to_json(nlohmann::ordered_json& out, const Panel& panel);
+// Throws std::invalid_argument "panel JSON: ..." for a missing or mistyped field, an unknown kind or a panel that
+// breaks validate_panel's rules.
+void from_json(const nlohmann::json& in, Panel& panel);
+void from_json(const nlohmann::ordered_json& in, Panel& panel);
 
 // Talbot-Plateau: the eye sees the time average of linear light over a pair.
 cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b);

@@ -1,0 +1,251 @@
+// The state and plumbing both fixed-point schedules share (fixed_core.hpp): eye states, output, LCD frame stores,
+// the per-pixel full and reduced frame steps, skip gates, stage taps and statistics.
+#include "fixed_core.hpp"
+#include "lost_view.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace trm::fixed_detail {
+
+FixedDecoderCore::FixedDecoderCore(FixedDecoderConfig config) : kernels_(config) {}
+
+EyeState& FixedDecoderCore::begin(const LinkFrame& frame, const char* who) {
+  detail::check_link_frame(frame, kernels_.config().decoder.link, who);
+  const FrameMeta& meta = frame.meta;
+  const cv::Size full(meta.full_width, meta.full_height);
+  EyeState& eye = eyes_[meta.eye];
+  if (eye.full_size != full) {
+    eye = EyeState();
+    eye.full_size = full;
+  }
+  return eye;
+}
+
+FrameOutput FixedDecoderCore::start_output(const LinkFrame& frame) const {
+  FrameOutput out;
+  const cv::Size full(frame.meta.full_width, frame.meta.full_height);
+  out.frame.meta = frame.meta;
+  out.frame.meta.width = full.width;
+  out.frame.meta.height = full.height;
+  out.frame.wanted_linear.create(full, CV_64FC3);
+  out.frame.drive.create(full, CV_64FC3);
+  out.frame.drive_codes.create(full, CV_16UC3);
+  out.frame.emitted_linear.create(full, CV_64FC3);
+  return out;
+}
+
+void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
+  if (!kernels_.lcd()) return;
+  out.lcd_held = eye.lcd_previous_drive.empty();
+  if (out.lcd_held) {
+    // Not read on the held frame (lcd_drive takes x_{t-1} = x_t and the held code); zeroed to stay defined.
+    eye.lcd_previous_drive = cv::Mat::zeros(eye.full_size, CV_16UC3);
+    eye.lcd_previous_linear = cv::Mat::zeros(eye.full_size, CV_32SC3);
+  }
+}
+
+Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const {
+  const int k = 3 * x + ch;
+  out.frame.wanted_linear.ptr<double>(y)[k] = kernels_.linear_to_double(wanted);
+  if (!kernels_.lcd()) {
+    const std::uint16_t code = kernels_.drive_code(wanted, ch);
+    out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(kernels_.drive_value(wanted, ch));
+    out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = code;
+    out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(code, 0, ch);
+    return 0;
+  }
+  // LCD frame stores: v_{t-1} and x_{t-1} at this sample are read, then replaced by this frame's.
+  std::uint16_t& previous_code = eye.lcd_previous_drive.ptr<std::uint16_t>(y)[k];
+  std::int32_t& previous_linear = eye.lcd_previous_linear.ptr<std::int32_t>(y)[k];
+  const LcdSample s = kernels_.lcd_drive(wanted, previous_linear, previous_code, out.lcd_held);
+  out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(s.drive);
+  out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = s.code;
+  out.tally.counts.lcd_unreachable += s.unreachable ? 1 : 0;
+  const bool contributed = config().decoder.lcd_history == LcdHistory::Contributed;
+  out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(s.code, s.previous_code, ch);
+  previous_code = s.code;
+  previous_linear = static_cast<std::int32_t>(contributed ? s.contributed : wanted);
+  return out.full ? s.shortfall : 0;
+}
+
+void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x,
+                                  const std::uint16_t* codes_row, const std::uint16_t* low0,
+                                  const std::uint16_t* low1, std::int32_t* residual_row, bool lost) const {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+  FrameTally& t = out.tally;
+  for (int ch = 0; ch < 3; ++ch) {
+    const Raw low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
+    const Raw full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
+    // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
+    const CompensatedSample s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
+    if (out.taps != nullptr) {
+      tap(out, Stage::Linear, y, x, ch, full_linear);
+      tap(out, Stage::LowPass, y, x, ch, low_linear);
+      tap(out, Stage::Beta, y, x, ch, s.shown + s.rho);
+      tap(out, Stage::Shown, y, x, ch, s.shown);
+    }
+    t.clipped += s.clipped ? 1 : 0;
+    t.counts.beta_clipped += s.clipped ? 1 : 0;
+    // LCD: an unreachable drive's shortfall joins rho (Sec. 4.4) before the residual store.
+    const Raw shortfall = emit(out, eye, y, x, ch, s.shown);
+    const StoredResidual stored = kernels_.store_residual(s.rho + shortfall);
+    residual_row[3 * x + ch] = static_cast<std::int32_t>(stored.value);
+    tap(out, Stage::Residual, y, x, ch, stored.value);
+    t.counts.residual_saturated += stored.saturated ? 1 : 0;
+    t.counts.residual_rounded += stored.rounded ? 1 : 0;
+    const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
+    t.residual_abs_sum += magnitude;
+    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
+  }
+}
+
+void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const {
+  if (!skipping()) return;
+  const int height = eye.full_size.height;
+  if (y == 0) eye.residual_nonzero.assign(static_cast<std::size_t>(height), 0);
+  // The OR of the line's residual samples, accumulated as they are produced (one flip-flop) and kept as the line's
+  // flag: a line held all zero is not written to the store.
+  const int samples = 3 * eye.full_size.width;
+  const bool nonzero = std::any_of(residual_row, residual_row + samples, [](std::int32_t v) { return v != 0; });
+  eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
+  out.tally.counts.residual_write_lines_skipped += nonzero ? 0 : 1;
+}
+
+void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
+                                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
+                                     const std::int32_t* residual_row, const ReducedLineGate* gate) const {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+  Raw alpha[3];
+  for (int ch = 0; ch < 3; ++ch) {
+    alpha[ch] = kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
+    tap(out, Stage::Alpha, y, x, ch, alpha[ch]);
+  }
+  const bool motion_static = gate != nullptr && gate->motion_static;
+  const bool residual_zero = gate != nullptr && gate->residual_zero;
+  if (residual_row == nullptr && !residual_zero) {
+    // No full frame just before: alpha alone (U of codes stays within [0, 1]; the clamp only guards).
+    for (int ch = 0; ch < 3; ++ch) {
+      const Raw shown = std::clamp(alpha[ch], Raw{0}, kernels_.one());
+      tap(out, Stage::AlphaPrime, y, x, ch, shown);
+      emit(out, eye, y, x, ch, shown);
+    }
+    return;
+  }
+  // L_{t-1} for the motion test, from the stored d_{t-1}: the low-pass the full frame compensated against, bit for
+  // bit (d_t rounds exact ties up, as the encoder's reduced frame does, so for static content it is the received i).
+  Raw previous[3];
+  for (int ch = 0; ch < 3; ++ch) {
+    // Static line (DESIGN §7): the d_{t-1} rows equal the received ones, so U of them is alpha.
+    previous[ch] = motion_static ? alpha[ch]
+                                 : kernels_.linear_of_upsampled(kernels_.upsample(prev0, prev1, col, row.upper, ch));
+  }
+  FrameTally& t = out.tally;
+  bool underflow = false;
+  const Raw weight = motion_static ? kernels_.one()  // c = 0: w = 1 exactly (DESIGN §4)
+                                   : kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);
+  if (out.taps != nullptr) {
+    for (int ch = 0; ch < 3; ++ch) tap(out, Stage::PreviousLowPass, y, x, ch, previous[ch]);
+    tap(out, Stage::Contrast, y, x, 0, kernels_.motion_contrast(kernels_.luma(previous), kernels_.luma(alpha)));
+    tap(out, Stage::Weight, y, x, 0, weight);
+  }
+  t.weight_sum += weight;
+  t.counts.weight_underflow += underflow ? 1 : 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    const Raw residual = residual_zero ? 0 : residual_row[3 * x + ch];
+    const WeightedSample s = residual_zero ? kernels_.clamp_alpha(alpha[ch])
+                                           : kernels_.add_weighted_residual(alpha[ch], weight, residual);  // Eq. 4
+    t.clipped += s.clipped ? 1 : 0;
+    t.counts.alpha_clipped += s.clipped ? 1 : 0;
+    t.dropped_sum += s.dropped;
+    const Raw magnitude = residual < 0 ? -residual : residual;
+    t.residual_abs_sum += magnitude;
+    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
+    tap(out, Stage::AlphaPrime, y, x, ch, s.alpha_prime);
+    emit(out, eye, y, x, ch, s.alpha_prime);
+  }
+}
+
+void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full,
+                                  bool residual) const {
+  const FixedDecoderConfig& c = config();
+  const int F = c.linear_frac_bits;
+  const int b = c.decoder.link.bits;
+  const std::string linear = "uQ1." + std::to_string(F);
+  taps = FixedStageTaps();
+  const auto add = [&](Stage stage, const std::string& format, int bits, bool is_signed,
+                       cv::Size size, int channels) {
+    FixedStagePlane& p = taps[stage];
+    p.present = true;
+    p.name = stage_name(stage);
+    p.format = format;
+    p.bits = bits;
+    p.is_signed = is_signed;
+    p.size = size;
+    p.channels = channels;
+    p.values.assign(static_cast<std::size_t>(size.width) * static_cast<std::size_t>(size.height) * static_cast<std::size_t>(channels), 0);
+  };
+  const std::string code = "uQ" + std::to_string(b) + ".0";
+  add(Stage::Codes, code, b, false, full ? g.full : g.reduced, 3);
+  if (full) {
+    add(Stage::Linear, linear, 1 + F, false, g.full, 3);
+    add(Stage::Reduced, code, b, false, g.reduced, 3);
+    add(Stage::LowPass, linear, 1 + F, false, g.full, 3);
+    add(Stage::Beta, "sQ3." + std::to_string(F), 3 + F, true, g.full, 3);
+    add(Stage::Shown, linear, 1 + F, false, g.full, 3);
+    add(Stage::Residual, std::string("sQ") + std::to_string(c.residual.int_bits) + "." + std::to_string(c.residual.frac_bits),
+        c.residual.width(), true, g.full, 3);
+  } else {
+    add(Stage::Alpha, linear, 1 + F, false, g.full, 3);
+    if (residual) {
+      add(Stage::PreviousLowPass, linear, 1 + F, false, g.full, 3);
+      add(Stage::Contrast, linear, 1 + F, false, g.full, 1);
+      add(Stage::Weight, linear, 1 + F, false, g.full, 1);
+    }
+    add(Stage::AlphaPrime, linear, 1 + F, false, g.full, 3);
+  }
+  const int o = c.decoder.output_bits;
+  add(Stage::Drive, "uQ" + std::to_string(o) + ".0", o, false, g.full, 3);
+  out.taps = &taps;
+}
+
+DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied) {
+  const FrameTally& t = out.tally;
+  const double samples = 3.0 * static_cast<double>(out.frame.wanted_linear.total());
+  FrameStats& stats = out.frame.stats;
+  stats.concealed_lines = out.concealed_lines;
+  stats.clipped_fraction = static_cast<double>(t.clipped) / samples;
+  if (full || residual_applied) {
+    stats.residual_mean_abs = kernels_.residual_to_double(t.residual_abs_sum) / samples;
+    stats.residual_max_abs = kernels_.residual_to_double(t.residual_abs_max);
+  }
+  if (residual_applied) {
+    stats.residual_applied = true;
+    stats.dropped_sum = kernels_.linear_to_double(t.dropped_sum);
+    stats.mean_motion_weight = kernels_.linear_to_double(t.weight_sum) / (samples / 3.0);
+  }
+  stats.lcd_unreachable_fraction = static_cast<double>(t.counts.lcd_unreachable) / samples;
+  last_counts_ = t.counts;
+  eye.last_output = out.frame;  // the held-output store (drive codes), shared, as the reference keeps it
+  return std::move(out.frame);
+}
+
+detail::Arrival FixedDecoderCore::classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact,
+                                           detail::Concealment& out, const char* who) {
+  const detail::Arrival arrival = detail::classify_arrival(frame, line_intact, out, who);
+  if (arrival == detail::Arrival::Partial) out.substitute = detail::concealment_substitute(eyes_, frame);
+  return arrival;
+}
+
+DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
+  check_view_meta(meta, std::string(who).append(": lost view: "));
+  last_counts_ = FixedStageCounts();
+  return detail::hold_lost_view(eyes_[meta.eye], meta);
+}
+
+
+}  // namespace trm::fixed_detail

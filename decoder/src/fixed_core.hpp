@@ -1,0 +1,133 @@
+// The state and plumbing both fixed-point schedules share: what persists per eye (DESIGN §5 frame stores), the
+// output frame under construction, and the per-pixel full and reduced frame steps over the stage arithmetic of
+// fixed_kernels.hpp.
+#pragma once
+
+#include "fixed_kernels.hpp"
+#include "view_arrival.hpp"
+
+#include <cstdint>
+#include <map>
+#include <opencv2/core.hpp>
+#include <span>
+#include <vector>
+
+namespace trm::fixed_detail {
+
+// Order-independent accumulators of one frame (integers, so both schedules report identical statistics).
+struct FrameTally {
+  FixedStageCounts counts;
+  std::uint64_t clipped = 0;     // samples for FrameStats::clipped_fraction
+  Raw dropped_sum = 0;           // uQ.F
+  Raw weight_sum = 0;            // uQ.F over pixels
+  Raw residual_abs_sum = 0;      // in residual format LSBs
+  Raw residual_abs_max = 0;
+};
+
+// What persists between frames of one eye (DESIGN §5 frame stores).
+struct EyeState {
+  cv::Size full_size;
+  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} codes, full size, CV_16UC3 (empty: no history yet)
+  cv::Mat lcd_previous_linear;  // LCD: x_{t-1}, full size, CV_32SC3 sQ.F
+  bool have_residual = false;
+  std::int64_t residual_index = 0;
+  cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
+  cv::Mat previous_low;   // d_t codes, reduced size, CV_16UC3
+  std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
+  DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
+                             // view is lost
+};
+
+// The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
+// flags of its U source rows and the full frame's residual line flag.
+struct ReducedLineGate {
+  bool motion_static = false;  // L_{t-1} = alpha on the whole line: w = 1, no motion test
+  bool residual_zero = false;  // rho all zero on the line: no residual read, no add
+};
+
+// Output frame under construction and the per-pixel emission shared by both schedules.
+struct FrameOutput {
+  DecodedFrame frame;
+  FrameTally tally;
+  bool lcd_held = false;  // LCD: the eye's first frame (no v_{t-1} yet)
+  bool full = false;
+  int concealed_lines = 0;
+  FixedStageTaps* taps = nullptr;  // test vectors: stage planes to fill (frame-at-a-time schedule only)
+};
+
+// The state and plumbing shared by both schedules: configuration, ROMs, eye states and output.
+class FixedDecoderCore {
+ public:
+  explicit FixedDecoderCore(FixedDecoderConfig config);
+
+  FixedKernels& kernels() { return kernels_; }
+  const FixedDecoderConfig& config() const { return kernels_.config(); }
+  const FixedStageCounts& last_counts() const { return last_counts_; }
+
+  // Checks the frame and returns the eye state (reset on a change of view size).
+  EyeState& begin(const LinkFrame& frame, const char* who);
+  // Classifies a line mask (detail::classify_arrival) and, for a partial view, takes the substitute d_{t-1} from
+  // this decoder's eyes (detail::concealment_substitute).
+  detail::Arrival classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact,
+                           detail::Concealment& out, const char* who);
+  // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
+  DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
+  // Allocates the output matrices at full size.
+  FrameOutput start_output(const LinkFrame& frame) const;
+  // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
+  Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
+  // Prepares the LCD frame stores of the eye for this frame (first frame: held history).
+  void begin_lcd(FrameOutput& out, EyeState& eye) const;
+  // One full-frame pixel, all channels (Eq. 2): U of the d_t rows i0/i1 of output row y, L, I from the codes row,
+  // beta, shown (emitted), rho into residual_row. A lost (concealed) line takes beta = L.
+  void full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* codes_row,
+                  const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row,
+                  bool lost = false) const;
+  // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
+  // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
+  // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are not read);
+  // residual_zero reads no residual (residual_row may then be null) and adds nothing.
+  void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
+                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
+                     const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr) const;
+  // DESIGN §7 skips (no-ops unless config().skip_unneeded):
+  // after full-frame output line y: flags the line of the residual store whose rho is not all zero (the write
+  // gate), counting the lines not written;
+  void end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const;
+  bool skipping() const { return config().skip_unneeded; }
+  // the gate of reduced-frame output line y from the comparator flags of its source rows (row_flags(k) gives row k's
+  // FixedKernels::compare_line result), counting the skip events.
+  template <typename RowFlags>
+  ReducedLineGate reduced_line_gate(FrameOutput& out, const EyeState& eye, const Geometry& g, int y,
+                                    RowFlags row_flags) const {
+    const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    const std::uint8_t f0 = row_flags(row.i0);
+    // With a lower-row weight of 0, U reads the upper row alone (bilinear blend, exactly).
+    const std::uint8_t f1 = row.upper == 0 ? static_cast<std::uint8_t>(FixedKernels::kLineStatic) : row_flags(row.i1);
+    ReducedLineGate gate;
+    gate.motion_static = (f0 & f1 & FixedKernels::kLineStatic) != 0;
+    gate.residual_zero = eye.residual_nonzero.size() == static_cast<std::size_t>(g.full.height) &&
+                         eye.residual_nonzero[static_cast<std::size_t>(y)] == 0;
+    out.tally.counts.motion_test_lines_skipped += gate.motion_static ? 1 : 0;
+    out.tally.counts.residual_read_lines_skipped += gate.residual_zero ? 1 : 0;
+    return gate;
+  }
+  // Test vectors: marks the stages of this frame kind present in taps, sized and formatted, and attaches them.
+  void start_taps(FrameOutput& out, FixedStageTaps& taps, const Geometry& g, bool full, bool residual) const;
+  // Records one value of a stage plane (no-op without taps).
+  static void tap(FrameOutput& out, Stage stage, int y, int x, int ch, Raw value) {
+    if (out.taps == nullptr) return;
+    FixedStagePlane& p = (*out.taps)[stage];
+    p.values[(static_cast<std::size_t>(y) * static_cast<std::size_t>(p.size.width) + static_cast<std::size_t>(x)) *
+                 static_cast<std::size_t>(p.channels) + static_cast<std::size_t>(ch)] = value;
+  }
+  // Fills FrameStats from the tally, remembers the counts and the eye's output.
+  DecodedFrame finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied);
+
+ private:
+  FixedKernels kernels_;
+  std::map<int, EyeState> eyes_;
+  FixedStageCounts last_counts_;
+};
+
+}  // namespace trm::fixed_detail

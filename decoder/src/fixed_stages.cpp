@@ -1,0 +1,241 @@
+// The per-pixel stage arithmetic of the fixed-point decoder (DESIGN §4-5), integer only, one function per stage;
+// both schedules call these.
+#include "fixed_kernels.hpp"
+#include "fixed_tables.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace trm::fixed_detail {
+
+Raw FixedKernels::gaussian_horizontal(const std::uint16_t* codes_row, const PolyphaseTaps& taps, int ch) const {
+  if (linear_space_) {
+    Raw acc = 0;  // uQ1.P x uQ0.T
+    for (std::size_t i = 0; i < taps.weight.size(); ++i) {
+      acc += taps.weight[i] * resample_rom_[codes_row[3 * taps.index[i] + ch]];
+    }
+    return fx::rounded_shift(acc, config_.linear_gaussian_tap_frac_bits, fx::Quant::Rnd);  // uQ1.P
+  }
+  Raw acc = 0;  // codes x uQ0.T
+  for (std::size_t i = 0; i < taps.weight.size(); ++i) acc += taps.weight[i] * codes_row[3 * taps.index[i] + ch];
+  // uQb.L, half to even: rows a, b with a + b an integer (255 - pattern) keep a + b exact, so an exact half-code
+  // tie of the vertical sum stays exact and rounds up as the encoder rounds it.
+  const int shift = config_.gaussian_tap_frac_bits - config_.gaussian_line_frac_bits;
+  return fx::rounded_shift(acc, shift, fx::Quant::RndConv);
+}
+
+std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const {
+  Raw acc = 0;  // uQb.(L + T); linear space uQ1.(P + T)
+  for (std::size_t j = 0; j < taps.weight.size(); ++j) acc += taps.weight[j] * rows[j][sample];
+  if (linear_space_) return encode_linear(fx::rounded_shift(acc, config_.linear_gaussian_tap_frac_bits, fx::Quant::Rnd));
+  // Q_b: the nearest code, exact half-code ties up, as the encoder's quantise_reduced (which counts a double D within
+  // its rounding noise of a half as the half); taps sum to 1, so no clamp is needed.
+  return static_cast<std::uint16_t>(fx::rounded_shift(acc, config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits, fx::Quant::Rnd));
+}
+
+std::uint16_t FixedKernels::encode_linear(Raw x) const {
+  // Binary search over the threshold ROM: b comparisons per reduced sample.
+  return threshold_search(encode_thresholds_, x);
+}
+
+Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper,
+                        Raw row_upper) const {
+  const Raw unit = Raw{1} << config_.bilinear_weight_frac_bits;
+  if (linear_space_) {
+    // U on linear light: the four codes through the I ROM (uQ1.F), result uQ1.F. The exact sum has 1 + F + 2W bits
+    // (77 at the defaults): a 128-bit accumulator.
+    using Wide = fx::detail::int128;
+    const Wide top = (unit - col_upper) * code_rom_[static_cast<std::size_t>(top_left)] +
+                     col_upper * code_rom_[static_cast<std::size_t>(top_right)];
+    const Wide bottom = (unit - col_upper) * code_rom_[static_cast<std::size_t>(bottom_left)] +
+                        col_upper * code_rom_[static_cast<std::size_t>(bottom_right)];
+    const int shift = 2 * config_.bilinear_weight_frac_bits;
+    return static_cast<Raw>(fx::rounded_shift((unit - row_upper) * top + row_upper * bottom, shift, fx::Quant::Rnd));
+  }
+  const Raw top = (unit - col_upper) * top_left + col_upper * top_right;            // uQb.W
+  const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
+  const Raw blended = (unit - row_upper) * top + row_upper * bottom;               // uQb.2W
+  return fx::rounded_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_frac_bits, fx::Quant::Rnd);  // uQb.U
+}
+
+Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col,
+                           Raw row_upper, int ch) const {
+  return blend(row0[3 * col.i0 + ch], row0[3 * col.i1 + ch], row1[3 * col.i0 + ch], row1[3 * col.i1 + ch], col.upper,
+               row_upper);
+}
+
+Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
+  if (linear_space_) return upsampled;
+  // The top bits of U's output address the ROM node, the rest weigh the step to the next node (wider than the
+  // table's own input code, which stops at 24 bits).
+  const int weight_bits = config_.upsample_frac_bits - config_.eotf_segments_per_code_log2;
+  return eotf_->interpolate(static_cast<std::size_t>(upsampled >> weight_bits),
+                            static_cast<std::uint64_t>(upsampled & ((Raw{1} << weight_bits) - 1)), weight_bits);
+}
+
+CompensatedSample FixedKernels::split(Raw beta) const {
+  CompensatedSample out;
+  out.shown = std::clamp(beta, Raw{0}, one());
+  out.clipped = out.shown != beta;
+  out.rho = beta - out.shown;  // sQ2.F in [-1, 1]
+  return out;
+}
+
+StoredResidual FixedKernels::store_residual(Raw rho) const {
+  StoredResidual out;
+  if (rho == 0) return out;  // zero in every format (the common case: beta within [0, 1])
+  fx::SaturationCounter saturation;
+  out.value = fx::quantise_raw(rho, config_.linear_frac_bits, config_.residual, &saturation);
+  out.saturated = saturation.overflows != 0;
+  out.rounded = !out.saturated && fx::rounded_shift(out.value, config_.residual.frac_bits - config_.linear_frac_bits, fx::Quant::Rnd) != rho;
+  return out;
+}
+
+Raw FixedKernels::scaled_merge(const std::array<Raw, 4>& p, Raw t, Raw j) const {
+  // M(T, vp) with T = t / (2 Mx), vp = 2 j / (2 Mx), times (2 Mx)^2: every term is an exact integer.
+  const Raw two_top = 2 * static_cast<Raw>(max_output_code());
+  const Raw vp2 = 2 * j;
+  return p[0] * (t * t + vp2 * vp2) + p[1] * (t * vp2) + p[2] * (two_top * (t + vp2)) + p[3] * (two_top * two_top);
+}
+
+Raw FixedKernels::lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const {
+  // v between the thresholds around `code`, interpolated linearly in M (reports only; the code is exact).
+  const Raw two_top = 2 * static_cast<Raw>(max_output_code());
+  const Raw t_lo = std::max<Raw>(0, 2 * code - 1);
+  const Raw t_hi = std::min<Raw>(two_top, 2 * code + 1);
+  const Raw m_lo = scaled_merge(p, t_lo, j);
+  const Raw m_hi = scaled_merge(p, t_hi, j);
+  const fx::detail::int128 span = m_hi - m_lo;
+  if (span <= 0) return (t_lo << config_.drive_frac_bits) / two_top;  // coefficients quantised to a flat merge
+  const fx::detail::int128 offset = std::clamp<fx::detail::int128>(target_scaled - m_lo, 0, span);
+  const fx::detail::int128 numerator = (static_cast<fx::detail::int128>(t_lo) * span + offset * (t_hi - t_lo))
+                                       << config_.drive_frac_bits;
+  const fx::detail::int128 denominator = span * two_top;
+  return static_cast<Raw>((numerator + denominator / 2) / denominator);
+}
+
+LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const {
+  const int F = config_.linear_frac_bits;
+  const int top = max_output_code();
+  const Raw two_top = 2 * static_cast<Raw>(top);
+  LcdSample out;
+  // m = ((x_t + x_{t-1}) / 2)^(1/gamma): the sum is the average in uQ1.(F+1); the LUT takes its top 24 bits.
+  const Raw sum = held ? 2 * wanted : wanted + previous_wanted;
+  Raw target = 0;
+  if (sum >= (Raw{1} << (F + 1))) {
+    target = one();
+  } else if (sum > 0) {
+    const int shift = F + 1 - lcd_target_lut_->shape().input_bits;
+    target = lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> shift));
+  }
+  const Raw target_scaled = target * (two_top * two_top);  // m (2 Mx)^2 2^F, as scaled_merge
+  const auto search = [&](const std::array<Raw, 4>& p, Raw j) {
+    int lo = 0;
+    int hi = top;
+    while (lo < hi) {  // the largest k with M(T_k, vp) <= m (M increases with T)
+      const int mid = (lo + hi + 1) / 2;
+      if (target_scaled >= scaled_merge(p, 2 * static_cast<Raw>(mid) - 1, j)) lo = mid; else hi = mid - 1;
+    }
+    return lo;
+  };
+  // First frame of the eye: the pixel is taken as held at x_t (M(v, v) = x_t^(1/gamma), the same m).
+  const Raw j = held ? search(lcd_held_coefficients_, 0) : previous_code;
+  const Raw x_previous = held ? wanted : previous_wanted;
+  out.previous_code = static_cast<std::uint16_t>(j);
+  out.contributed = wanted;
+  // Reachability is decided in linear light, on the sum x_t + x_{t-1} against 2 M(0|1, v_{t-1})^gamma from the same
+  // ROMs the shortfall uses. The exact ends of the range are met exactly: white after white (the ROM holds 1.0),
+  // black after black, and with LcdHistory::Contributed the next target, which is built from the ROM value itself.
+  // (In m, the 1/gamma power and the quantised coefficients would blur these ends by many LSB near black.)
+  const bool below = sum < 2 * lcd_end_luminance_[0][static_cast<std::size_t>(j)];
+  const bool above = sum > 2 * lcd_end_luminance_[1][static_cast<std::size_t>(j)];
+  if (below || above) {
+    // No root in [0, 1]: v clamps to the nearer end; frame t contributes x_eff = 2 M(v, v_prev)^gamma - x_{t-1}.
+    out.unreachable = true;
+    out.code = static_cast<std::uint16_t>(above ? top : 0);
+    out.drive = above ? Raw{1} << config_.drive_frac_bits : 0;
+    const Raw x_effective = 2 * lcd_end_luminance_[above ? 1 : 0][static_cast<std::size_t>(j)] - x_previous;
+    out.shortfall = wanted - x_effective;
+    out.contributed = x_effective;
+    return out;
+  }
+  out.code = static_cast<std::uint16_t>(search(lcd_coefficients_, j));
+  out.drive = lcd_drive_value(lcd_coefficients_, target_scaled, out.code, j);
+  return out;
+}
+
+Raw FixedKernels::luma(const Raw* rgb) const {
+  const Raw sum = luma_weights_[0] * rgb[0] + luma_weights_[1] * rgb[1] + luma_weights_[2] * rgb[2];
+  return fx::rounded_shift(sum, config_.luma_weight_frac_bits, fx::Quant::Rnd);  // uQ1.F
+}
+
+Raw FixedKernels::motion_weight(Raw luma_previous, Raw luma_alpha, bool& underflow) const {
+  underflow = false;
+  const int F = config_.linear_frac_bits;
+  const Raw sum = luma_previous + luma_alpha;  // uQ2.F
+  const Raw difference = luma_previous > luma_alpha ? luma_previous - luma_alpha : luma_alpha - luma_previous;
+  if (difference == 0) return one();  // c = 0 (including a zero sum): w = 1 exactly, for every s
+  if (sensitivity_infinite_) return 0;
+  if (config_.decoder.sensitivity == 0.0) return one();
+  const Raw contrast = contrast_of(difference, sum);
+  // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
+  const Raw x = fx::rounded_shift(sensitivity_raw_ * contrast,
+                            config_.sensitivity_frac_bits + F - config_.exp_input_frac_bits, fx::Quant::Rnd);
+  const Raw integer_part = x >> config_.exp_input_frac_bits;
+  if (integer_part >= 16) {
+    underflow = true;
+    return 0;
+  }
+  const Raw fraction = x & ((Raw{1} << config_.exp_input_frac_bits) - 1);
+  const Raw e_fraction = exp_fraction_->evaluate_raw(static_cast<std::uint32_t>(fraction));
+  return fx::rounded_shift(exp_integer_rom_[static_cast<std::size_t>(integer_part)] * e_fraction, F, fx::Quant::Rnd);
+}
+
+Raw FixedKernels::contrast_of(Raw difference, Raw sum) const {
+  // Eq. 5: c = difference / sum = difference * mantissa 2^-24 2^-e, uQ1.F (clamped to 1 against LUT error).
+  const fx::NormalisedReciprocal reciprocal =
+      fx::reciprocal_normalised(*reciprocal_, static_cast<std::uint64_t>(sum), config_.linear_frac_bits);
+  const fx::detail::int128 product = static_cast<fx::detail::int128>(difference) * reciprocal.mantissa_raw;
+  const int shift = reciprocal_->shape().output_frac_bits + reciprocal.exponent;
+  const fx::detail::int128 c128 = fx::rounded_shift(product, shift, fx::Quant::Rnd);
+  return static_cast<Raw>(std::min<fx::detail::int128>(c128, one()));
+}
+
+Raw FixedKernels::motion_contrast(Raw luma_previous, Raw luma_alpha) const {
+  const Raw difference = luma_previous > luma_alpha ? luma_previous - luma_alpha : luma_alpha - luma_previous;
+  return difference == 0 ? 0 : contrast_of(difference, luma_previous + luma_alpha);
+}
+
+WeightedSample FixedKernels::add_weighted_residual(Raw alpha, Raw weight, Raw residual) const {
+  WeightedSample out;
+  // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho is uQ1.F x sQ.R, rounded to F fraction bits.
+  const Raw sum = alpha + fx::rounded_shift(weight * residual, config_.residual.frac_bits, fx::Quant::Rnd);
+  out.alpha_prime = std::clamp(sum, Raw{0}, one());
+  out.clipped = out.alpha_prime != sum;
+  out.dropped = sum > out.alpha_prime ? sum - out.alpha_prime : out.alpha_prime - sum;
+  return out;
+}
+
+WeightedSample FixedKernels::clamp_alpha(Raw alpha) const {
+  WeightedSample out;
+  out.alpha_prime = std::clamp(alpha, Raw{0}, one());
+  out.clipped = out.alpha_prime != alpha;
+  out.dropped = alpha > out.alpha_prime ? alpha - out.alpha_prime : out.alpha_prime - alpha;
+  return out;
+}
+
+std::uint8_t FixedKernels::compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples) {
+  return std::equal(stored, stored + samples, received) ? kLineStatic : std::uint8_t{0};
+}
+
+std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
+  // Binary search over the threshold ROM: o comparisons per sample.
+  return threshold_search(thresholds_[static_cast<std::size_t>(ch)], linear);
+}
+
+Raw FixedKernels::drive_value(Raw linear, int ch) const {
+  if (linear >= one()) return Raw{1} << config_.drive_frac_bits;
+  return drive_luts_[static_cast<std::size_t>(ch)]->evaluate_raw(static_cast<std::uint32_t>(linear >> drive_lut_shift_));
+}
+
+}  // namespace trm::fixed_detail

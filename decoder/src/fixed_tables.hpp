@@ -1,0 +1,41 @@
+// What the configuration check and the ROM construction of the fixed-point decoder both derive from a configuration:
+// the coefficient register format, the re-encoding thresholds, the integer tap weights, and the threshold-ROM search.
+#pragma once
+
+#include "trm/fixed_runtime.hpp"
+#include "trm/transfer.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace trm::fixed_detail {
+
+// Throws std::invalid_argument "FixedDecoderConfig: <stage>: <why>".
+[[noreturn]] void reject_config(const std::string& stage, const std::string& why);
+
+// The LCD merge coefficient registers: sQ7.F (|p| <= kMaxLcdCoefficient = 16 with the sign), F the linear-light
+// fraction bits.
+fx::RuntimeFormat lcd_coefficient_format(int linear_frac_bits);
+
+// The largest code k with x >= T_k in an increasing threshold ROM (T_0 = 0, one word per code): the quantiser of a
+// threshold ROM, by binary search (log2 of the ROM size comparisons).
+std::uint16_t threshold_search(const std::vector<std::int64_t>& thresholds, std::int64_t x);
+
+// Largest-remainder rounding of non-negative weights (summing to ~1) to integers summing exactly to 2^frac_bits.
+// A mirror-symmetric weight list (taps centred on an integer or half-integer position) stays exactly symmetric:
+// mirror pairs receive their extra units together, an odd unit goes to the centre tap. Exact symmetry keeps the
+// exact half-code ties of symmetric content (a Nyquist checkerboard at r = 1/2) exact, so that they round up as the
+// encoder's quantise_reduced rounds them (see FixedKernels::gaussian_vertical). Otherwise ties go to the lower index,
+// so the result is deterministic.
+// Weights that are not finite and non-negative with a positive sum (a degenerate Gaussian) are rejected, naming the
+// stage: converting NaN to an integer is undefined.
+std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, int frac_bits, const char* stage);
+
+// The linear resample space's re-encoding thresholds on the uQ1.frac_bits grid: T_k is the smallest grid value g
+// whose link code under the encoder's reduced-frame quantiser, quantise_reduced(enc(g 2^-f)) (round half up, within
+// its tie tolerance), is k or more (T_0 = 0). The code of any grid value x is then the largest k with x >= T_k,
+// exactly as the encoder quantises that value.
+std::vector<std::int64_t> link_code_thresholds(int bits, Transfer transfer, int frac_bits);
+
+}  // namespace trm::fixed_detail

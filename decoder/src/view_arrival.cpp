@@ -1,0 +1,98 @@
+// The input checks and the concealment classification every decoder shares (view_arrival.hpp).
+#include "view_arrival.hpp"
+
+#include "trm/resample.hpp"
+
+#include <stdexcept>
+
+namespace trm::detail {
+namespace {
+
+std::string size_text(int width, int height) { return std::to_string(width).append("x").append(std::to_string(height)); }
+
+}  // namespace
+
+std::string frame_name(const FrameMeta& meta) {
+  return std::string(to_string(meta.parity)) + " frame t=" + std::to_string(meta.index) +
+         " eye=" + std::to_string(meta.eye);
+}
+
+void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who) {
+  const FrameMeta& meta = frame.meta;
+  const std::string what = who + ": " + frame_name(meta) + ": ";
+  check_view_meta(meta, what);
+  if (meta.bits != link.bits) {
+    throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
+                                std::to_string(link.bits));
+  }
+  if (meta.transfer != link.transfer) {
+    throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
+                                to_string(link.transfer));
+  }
+  if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
+    throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
+  }
+  // The codes against their own metadata first (a mismatch there is named as such), then against the view size:
+  // both before any geometry of the view is built, so a frame claiming a view it cannot be part of allocates nothing.
+  const std::string codes_size = size_text(frame.codes.cols, frame.codes.rows);
+  if (frame.codes.cols != meta.width || frame.codes.rows != meta.height) {
+    throw std::invalid_argument(what + "codes are " + codes_size + " but the metadata says " +
+                                size_text(meta.width, meta.height));
+  }
+  const cv::Size full(meta.full_width, meta.full_height);
+  const cv::Size expected = meta.parity == Parity::Full
+                                ? full
+                                : cv::Size(reduced_size(full.width, link.reduction),
+                                           reduced_size(full.height, link.reduction));
+  if (frame.codes.size() != expected) {
+    throw std::invalid_argument(what + "codes are " + codes_size + " but a " + to_string(meta.parity) +
+                                " frame of a " + size_text(full.width, full.height) + " view at r=" +
+                                std::to_string(link.reduction) + " must be " +
+                                size_text(expected.width, expected.height));
+  }
+  double highest = 0.0;
+  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
+  if (highest > (1 << link.bits) - 1) {
+    throw std::invalid_argument(what + "code " + std::to_string(static_cast<int>(highest)) + " exceeds the " +
+                                std::to_string(link.bits) + "-bit range");
+  }
+}
+
+Arrival classify_arrival(const LinkFrame& frame, std::span<const std::uint8_t> line_intact, Concealment& out,
+                         const std::string& who) {
+  if (line_intact.empty()) return Arrival::Whole;
+  if (line_intact.size() != static_cast<std::size_t>(frame.codes.rows)) {
+    throw std::invalid_argument(who + ": line mask has " + std::to_string(line_intact.size()) +
+                                " entries for a view of " + std::to_string(frame.codes.rows) + " lines");
+  }
+  out = Concealment();
+  out.intact = line_intact;
+  out.first_intact = -1;
+  for (int y = 0; y < frame.codes.rows; ++y) {
+    if (out.lost(y)) {
+      ++out.lost_lines;
+    } else if (out.first_intact < 0) {
+      out.first_intact = y;
+    }
+  }
+  if (out.first_intact < 0) return Arrival::Lost;
+  if (out.lost_lines == 0) return Arrival::Whole;
+  return Arrival::Partial;
+}
+
+cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c) {
+  cv::Mat out = codes.clone();
+  for (int y = 0; y < codes.rows; ++y) {
+    if (!c.lost(y)) continue;
+    if (!c.substitute.empty()) {
+      c.substitute.row(y).copyTo(out.row(y));
+      continue;
+    }
+    // The nearest intact line above, else (lines above the first intact one) below. Lines above y are already
+    // concealed, so the line just above holds the nearest intact line above.
+    out.row(y < c.first_intact ? c.first_intact : y - 1).copyTo(out.row(y));
+  }
+  return out;
+}
+
+}  // namespace trm::detail

@@ -1,0 +1,59 @@
+// How a received view arrived, decided once for every decoder: the checks a view must pass before any stage runs,
+// and the classification of a line mask into a whole, partial or lost view with the concealment of a partial one
+// (DESIGN §4, README "Concealment"). The reference and both fixed-point schedules call these, so they reject the
+// same views with the same messages and conceal the same lines the same way.
+#pragma once
+
+#include "trm/decoder.hpp"
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+namespace trm::detail {
+
+// "<parity> frame t=<index> eye=<eye>", as messages name a view.
+std::string frame_name(const FrameMeta& meta);
+
+// Throws std::invalid_argument "<who>: <frame name>: <problem>" unless the view is one the link configuration can
+// produce: valid metadata, the link's bits and transfer, non-empty CV_16UC3 codes of the metadata's size, that size
+// the view's full or reduced size, and no code beyond the link bit depth.
+void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who);
+
+// A view that arrived with some lines lost (at least one lost, at least one intact): lost lines of a full frame feed
+// D as copies of the nearest intact line above (else below) and show L_t with rho = 0; lost lines of a reduced frame
+// repeat the row of the stored d_{t-1} (substitute) or, without one, the nearest intact line above (else below).
+struct Concealment {
+  std::span<const std::uint8_t> intact;  // one entry per line of the view; 0 = lost
+  int first_intact = 0;  // lost lines above it have no intact line above: they take this line's content
+  int lost_lines = 0;
+  cv::Mat substitute;    // reduced frames: the eye's d_{t-1} frame store (codes); empty: none
+  bool lost(int y) const { return intact[static_cast<std::size_t>(y)] == 0; }
+};
+
+// Whole: an empty mask or every line intact (decode as received); Lost: no line intact (decode_lost); Partial: some
+// lines lost, concealed as Concealment says.
+enum class Arrival { Whole, Partial, Lost };
+
+// Counts a line mask into `out` and classifies it. Throws std::invalid_argument ("<who>: line mask has ...") for a
+// mask whose length is not the view's line count. The substitute is left for the caller (concealment_substitute).
+Arrival classify_arrival(const LinkFrame& frame, std::span<const std::uint8_t> line_intact, Concealment& out,
+                         const std::string& who);
+
+// The d_{t-1} a partial reduced view's lost lines repeat: the eye's stored d_t when the eye holds a residual and a
+// d_t of the view's reduced size, looked up before a change of view size resets the eye; else empty. Over the
+// reference's and the fixed-point decoders' eye maps (same member names).
+template <typename EyeMap>
+cv::Mat concealment_substitute(const EyeMap& eyes, const LinkFrame& frame) {
+  if (frame.meta.parity != Parity::Reduced) return cv::Mat();
+  const auto found = eyes.find(frame.meta.eye);
+  if (found == eyes.end() || !found->second.have_residual || found->second.previous_low.size() != frame.codes.size()) {
+    return cv::Mat();
+  }
+  return found->second.previous_low;
+}
+
+// The codes of a partially received view with every lost line replaced (the frame-at-a-time form of the rules).
+cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c);
+
+}  // namespace trm::detail
