@@ -260,12 +260,4 @@ Panel parse_panel_spec(const std::string& spec) {
 
 }  // namespace
 
-cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b) {
-  if (linear_a.size() != linear_b.size() || linear_a.type() != linear_b.type() || linear_a.depth() != CV_64F) {
-    throw std::invalid_argument("perceived_pair: the two frames must be CV_64F of the same size and channels");
-  }
-  cv::Mat sum = linear_a + linear_b;
-  return sum * 0.5;
-}
-
 }  // namespace trm

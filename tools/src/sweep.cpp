@@ -2,6 +2,7 @@
 
 #include "hw_report.hpp"
 
+#include "trm/metrics.hpp"
 #include "trm/panel.hpp"
 
 #include <opencv2/imgproc.hpp>
@@ -185,7 +186,8 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
   SweepPoint p;
   p.residual_format = config.residual.to_string();
   const double levels = std::ldexp(1.0, config.decoder.output_bits) - 1.0;
-  double sum_lsb = 0.0, sum_sq_lsb = 0.0, sum_sq_linear = 0.0;
+  CodeAgreement codes;
+  double sum_sq_linear = 0.0;
   std::int64_t linear_samples = 0;
   // Decode time of every view in every repeat: the median per view over the repeats, averaged over the views.
   std::vector<std::vector<double>> view_seconds(rec.views.size());
@@ -227,15 +229,7 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
       const FixedStageCounts& counts = *decoder->stage_counts();
       p.residual_saturated += counts.residual_saturated;
       p.residual_rounded += counts.residual_rounded;
-      cv::Mat difference;
-      cv::absdiff(decoded.drive_codes, view.drive_codes, difference);
-      cv::Mat flat;
-      difference.reshape(1).convertTo(flat, CV_64F);
-      p.codes += static_cast<std::int64_t>(flat.total());
-      p.differing += cv::countNonZero(flat);
-      p.max_lsb = std::max(p.max_lsb, cv::norm(flat, cv::NORM_INF));
-      sum_lsb += cv::sum(flat)[0];
-      sum_sq_lsb += cv::norm(flat, cv::NORM_L2SQR);
+      codes += compare_codes(decoded.drive_codes, view.drive_codes);
       p.linear_max = std::max(p.linear_max, cv::norm(decoded.emitted_linear, view.emitted, cv::NORM_INF));
       sum_sq_linear += cv::norm(decoded.emitted_linear, view.emitted, cv::NORM_L2SQR);
       linear_samples += static_cast<std::int64_t>(view.emitted.total()) * view.emitted.channels();
@@ -244,10 +238,12 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
     p.repeat_seconds_per_frame.push_back(decode_seconds / static_cast<double>(rec.views.size()));
     if (sequence_done) sequence_done();
   }
-  const auto codes = static_cast<double>(p.codes);
-  p.identical_percent = 100.0 * static_cast<double>(p.codes - p.differing) / codes;
-  p.mean_lsb = sum_lsb / codes;
-  p.rms_lsb = std::sqrt(sum_sq_lsb / codes);
+  p.codes = codes.compared;
+  p.differing = codes.differing();
+  p.identical_percent = codes.identical_percent();
+  p.max_lsb = codes.max_lsb;
+  p.mean_lsb = codes.mean_lsb();
+  p.rms_lsb = codes.rms_lsb();
   p.linear_rms = std::sqrt(sum_sq_linear / static_cast<double>(linear_samples));
   for (const auto& seconds : view_seconds) {
     p.seconds_per_frame += median(seconds);
@@ -728,8 +724,9 @@ std::string sweep_markdown(const SweepResult& r) {
   s << "* memory: `FixedStreamingDecoder::report()` at " << o.hw_size.width << "x" << o.hw_size.height
     << ": on chip = line buffers + ROMs, off chip = frame stores; base " << kib(r.base.on_chip_bits) << " KiB on chip, "
     << kib(r.base.off_chip_bits) << " KiB off chip; Δ memory = on + off chip against the base\n";
-  s << "* criterion (DESIGN §6): ≥ " << kSweepIdenticalPercent << " % identical codes and max |Δ| ≤ "
-    << kSweepMaxLsb << " LSB; the cheapest value meeting it is the smallest value at and above which every "
+  s << "* criterion (DESIGN §6): ≥ " << kReferenceAgreementCriterion.min_identical_percent()
+    << " % identical codes and max |Δ| ≤ " << kReferenceAgreementCriterion.max_lsb
+    << " LSB; the cheapest value meeting it is the smallest value at and above which every "
        "accepted value meets it (every knob costs the same or more as it grows, and a value that passes below a "
        "failing one is not taken)\n\n";
   s << "## Summary\n\n" << summary_table_md(r) << "\n";
@@ -782,7 +779,8 @@ Json sweep_json(const SweepResult& r) {
                      {"seed", po.seed},
                      {"repeats", o.repeats},
                      {"hw_size", {o.hw_size.width, o.hw_size.height}}};
-  j["criterion"] = {{"identical_percent_at_least", kSweepIdenticalPercent}, {"max_lsb_at_most", kSweepMaxLsb}};
+  j["criterion"] = {{"identical_percent_at_least", kReferenceAgreementCriterion.min_identical_percent()},
+                    {"max_lsb_at_most", kReferenceAgreementCriterion.max_lsb}};
   j["reference_seconds_per_frame"] = r.reference_seconds_per_frame;
   const auto point_json = [&](const SweepPoint& p) {
     Json pj;
@@ -919,8 +917,8 @@ std::string sweep_summary(const SweepResult& r) {
     << percent_text(r.base) << " identical, max " << general(r.base.max_lsb) << " LSB, "
     << ms(r.base.seconds_per_frame) << " ms/view, " << kib(r.base.on_chip_bits) << " KiB on / "
     << kib(r.base.off_chip_bits) << " KiB off chip at " << r.options.hw_size.width << "x" << r.options.hw_size.height
-    << "\n  cheapest value with >= " << kSweepIdenticalPercent << " % identical and max <= " << kSweepMaxLsb
-    << " LSB:\n";
+    << "\n  cheapest value with >= " << kReferenceAgreementCriterion.min_identical_percent()
+    << " % identical and max <= " << kReferenceAgreementCriterion.max_lsb << " LSB:\n";
   s << "  " << std::left << std::setw(30) << "knob" << std::right << std::setw(6) << "base" << std::setw(10)
     << "cheapest" << std::setw(12) << "identical" << std::setw(5) << "max" << std::setw(11) << "on KiB"
     << std::setw(11) << "off KiB" << std::setw(10) << "d KiB" << std::setw(10) << "ms/view" << std::setw(9) << "min ms"

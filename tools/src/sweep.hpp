@@ -7,6 +7,7 @@
 #include "pipeline.hpp"
 
 #include "trm/fixed_decoder.hpp"
+#include "trm/metrics.hpp"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -52,10 +53,6 @@ struct SweepOptions {
   void validate() const;
 };
 
-// The acceptance criterion of DESIGN §6 applied to each point.
-inline constexpr double kSweepIdenticalPercent = 99.9;
-inline constexpr double kSweepMaxLsb = 1.0;
-
 struct SweepPoint {
   int value = 0;
   bool is_default = false;
@@ -90,7 +87,7 @@ struct SweepPoint {
 
   bool ok() const { return status == "ok"; }
   bool meets_criterion() const {
-    return ok() && identical_percent >= kSweepIdenticalPercent && max_lsb <= kSweepMaxLsb;
+    return ok() && kReferenceAgreementCriterion.met_by(codes - differing, codes, max_lsb);
   }
 };
 

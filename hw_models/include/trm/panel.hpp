@@ -2,8 +2,6 @@
 // merge model (Eq. 7) with its numerically stable inverse. Double precision (reference).
 #pragma once
 
-#include <opencv2/core.hpp>
-
 #include <array>
 #include <string>
 
@@ -62,8 +60,5 @@ void validate_panel(const Panel& panel, const std::string& what);
 // Throws std::invalid_argument with the list of accepted forms, for a malformed spec and for a panel that breaks
 // validate_panel's rules.
 Panel parse_panel(const std::string& spec);
-
-// Talbot-Plateau: the eye sees the time average of linear light over a pair.
-cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b);
 
 }  // namespace trm
