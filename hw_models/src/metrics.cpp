@@ -18,6 +18,10 @@ cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b) {
   return sum * 0.5;
 }
 
+cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, const cv::Mat& emitted) {
+  return panel.kind == PanelKind::Lcd ? emitted.clone() : perceived_pair(emitted_previous, emitted);
+}
+
 cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits) {
   const double levels = std::ldexp(1.0, output_bits) - 1.0;
   cv::Mat out(linear.size(), CV_64FC3);

@@ -34,6 +34,16 @@ TEST(PerceivedPair, IsTheTimeAverage) {
   EXPECT_THROW(perceived_pair(a, cv::Mat(2, 3, CV_32FC3)), std::invalid_argument);
 }
 
+TEST(PerceivedPair, OnAnLcdIsTheMergedEmission) {
+  const cv::Mat previous(1, 2, CV_64FC3, cv::Scalar::all(0.1));
+  const cv::Mat current(1, 2, CV_64FC3, cv::Scalar::all(0.3));
+  const cv::Mat oled = perceived_pair(parse_panel("vive"), previous, current);
+  EXPECT_EQ(oled.at<cv::Vec3d>(0, 1), cv::Vec3d::all(0.2));
+  const cv::Mat lcd = perceived_pair(parse_panel("lcd"), previous, current);
+  EXPECT_EQ(lcd.at<cv::Vec3d>(0, 1), cv::Vec3d::all(0.3));
+  EXPECT_NE(lcd.data, current.data);  // a copy: the caller keeps its frame
+}
+
 TEST(Psnr, OfAConstantErrorOnTheEncoding) {
   // Every sample 0.1 apart in sRGB: MSE 0.01, PSNR 20 dB.
   const cv::Mat a = to_linear(cv::Mat(4, 5, CV_64FC3, cv::Scalar::all(0.5)), Transfer::Srgb);

@@ -133,9 +133,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   EyeHistory& eye = eyes_[meta.eye];
   cv::Mat perceived;
   if (meta.index % 2 == 1 && eye.index == meta.index - 1) {
-    // OLED: Talbot-Plateau average of the two frames' emission. LCD: the panel model's emission of frame t
-    // is already the merged value of (v_t, v_{t-1}) over the pair.
-    perceived = panel_.kind == PanelKind::Lcd ? d.emitted_linear.clone() : perceived_pair(eye.emitted, d.emitted_linear);
+    perceived = perceived_pair(panel_, eye.emitted, d.emitted_linear);
     last_reference_pair_ = perceived_pair(eye.reference, reference);
     const double psnr = psnr_srgb(perceived, last_reference_pair_);
     const double max_abs = cv::norm(perceived, last_reference_pair_, cv::NORM_INF);

@@ -16,6 +16,10 @@ namespace trm {
 // Talbot-Plateau: the eye sees the time average of linear light over a pair.
 cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b);
 
+// The pair frames t-1 and t make on `panel`, from the light it emitted in each. OLED: their Talbot-Plateau average.
+// LCD: the emission of frame t, which the merge M(v_t, v_{t-1}) (Eq. 7) already makes the pair's.
+cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, const cv::Mat& emitted);
+
 // What `panel` emits for the linear frame (CV_64FC3, [0, 1]) when every frame is rendered and shown at full
 // resolution: the double-precision drive of each value, rounded to output_bits like any decoder's, emitted back.
 // The pair of two such frames is the full-rate reference a reduced-rate method's perceived pair is held to.
@@ -62,7 +66,7 @@ struct AgreementCriterion {
   double max_lsb = 0.0;
 
   constexpr double min_identical_percent() const { return 100.0 * min_identical_fraction; }
-  // `identical` of `compared` codes, the largest difference max_difference_lsb. Nothing compared never passes.
+  // `identical` of `compared` codes, the largest difference max_difference_lsb. An empty comparison fails.
   constexpr bool met_by(std::int64_t identical, std::int64_t compared, double max_difference_lsb) const {
     return compared > 0 &&
            static_cast<double>(identical) / static_cast<double>(compared) >= min_identical_fraction &&
