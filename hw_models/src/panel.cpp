@@ -229,11 +229,6 @@ double Panel::drive_from_linear(double x, int channel) const {
   return lcd.held().solve(std::pow(std::clamp(x, 0.0, 1.0), 1.0 / lcd.gamma), 0.0).v;
 }
 
-cv::Mat Panel::perceived_pair(const cv::Mat& first_emitted, const cv::Mat& second_emitted) const {
-  if (kind == PanelKind::Lcd) return second_emitted.clone();
-  return trm::perceived_pair(first_emitted, second_emitted);
-}
-
 bool operator==(const Panel& a, const Panel& b) {
   if (a.kind != b.kind || a.name != b.name) return false;
   return a.kind == PanelKind::Oled ? a.oled == b.oled : a.lcd == b.lcd;
@@ -422,13 +417,5 @@ void to_json(nlohmann::json& out, const Panel& panel) { write_panel(out, panel);
 void to_json(nlohmann::ordered_json& out, const Panel& panel) { write_panel(out, panel); }
 void from_json(const nlohmann::json& in, Panel& panel) { read_panel(in, panel); }
 void from_json(const nlohmann::ordered_json& in, Panel& panel) { read_panel(in, panel); }
-
-cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b) {
-  if (linear_a.size() != linear_b.size() || linear_a.type() != linear_b.type() || linear_a.depth() != CV_64F) {
-    throw std::invalid_argument("perceived_pair: the two frames must be CV_64F of the same size and channels");
-  }
-  cv::Mat sum = linear_a + linear_b;
-  return sum * 0.5;
-}
 
 }  // namespace trm

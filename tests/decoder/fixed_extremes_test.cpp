@@ -469,9 +469,7 @@ TEST(FixedExtremes, DegenerateAndOddSizes) {
             generated(4, [&](int t) { return test::checkerboard(size.width, size.height, 1, t % 2); })}) {
         const CaseRun run = run_case(encode_sequence(images, link), fixed_config(link), what);
         if (::testing::Test::HasFatalFailure()) return;
-        total.agreement.samples += run.agreement.samples;
-        total.agreement.identical += run.agreement.identical;
-        total.agreement.max_lsb = std::max(total.agreement.max_lsb, run.agreement.max_lsb);
+        total.agreement += run.agreement;
       }
     }
     expect_agrees(total, size_name(size) + " all r, stereo");
@@ -1107,7 +1105,7 @@ TEST(FixedExtremes, CounterPhaseBoardsAcrossReductions) {
                                                                     }),
                                                                     link);
               const CaseRun run = expect_case(frames, fixed_config(link, panel, output_bits), what);
-              differing += static_cast<std::int64_t>(run.agreement.samples - run.agreement.identical);
+              differing += run.agreement.differing();
             }
           }
         }

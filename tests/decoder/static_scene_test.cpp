@@ -1,6 +1,7 @@
 // Static content through TrmEncoder + ReferenceDecoder (OLED): Eq. 3, alpha' + beta = 2 I, and the perceived
 // pair equals I within output quantisation, with and without clipping, at any size and r.
 #include "decoder_test_support.hpp"
+#include "trm/metrics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -267,16 +267,6 @@ TEST(LcdPanel, HeldDriveRoundTripsEvenWhenTheMergeIsNotTheIdentity) {
   EXPECT_NEAR(lcd.drive_from_linear(0.3, 1), std::pow(0.3, 1.0 / 2.2), 1e-15);
 }
 
-TEST(PerceivedPair, IsTheTimeAverage) {
-  cv::Mat a(2, 3, CV_64FC3, cv::Scalar(0.2, 0.4, 1.0));
-  cv::Mat b(2, 3, CV_64FC3, cv::Scalar(0.6, 0.0, 1.0));
-  const cv::Mat p = perceived_pair(a, b);
-  ASSERT_EQ(p.type(), CV_64FC3);
-  EXPECT_EQ(p.at<cv::Vec3d>(1, 2), cv::Vec3d(0.4, 0.2, 1.0));
-  EXPECT_THROW(perceived_pair(a, cv::Mat(2, 2, CV_64FC3)), std::invalid_argument);
-  EXPECT_THROW(perceived_pair(a, cv::Mat(2, 3, CV_32FC3)), std::invalid_argument);
-}
-
 // The drive of x_t is the inverse of the emission: an OLED emits x again; an LCD pair driven (v_{t-1}, v_t) merges to
 // the average of what the two frames wanted, wherever that is reachable.
 TEST(PanelModel, DriveThenEmissionRoundTrips) {
@@ -365,13 +355,6 @@ TEST(PanelModel, EmissionTableIsTheEmissionOfEveryCode) {
       }
     }
   }
-}
-
-TEST(PanelModel, PerceivedPairAveragesOledAndTakesTheLcdMerge) {
-  const cv::Mat a(1, 2, CV_64FC3, cv::Scalar(0.2, 0.4, 1.0));
-  const cv::Mat b(1, 2, CV_64FC3, cv::Scalar(0.6, 0.0, 1.0));
-  EXPECT_EQ(parse_panel("vive").perceived_pair(a, b).at<cv::Vec3d>(0, 1), cv::Vec3d(0.4, 0.2, 1.0));
-  EXPECT_EQ(parse_panel("lcd").perceived_pair(a, b).at<cv::Vec3d>(0, 1), cv::Vec3d(0.6, 0.0, 1.0));
 }
 
 TEST(PanelJson, RoundTripsEveryKind) {

@@ -4,6 +4,7 @@
 #include "output_dir.hpp"
 #include "run_report.hpp"
 #include "sweep.hpp"
+#include "sweep_report.hpp"
 
 #include <iomanip>
 #include <iostream>

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -20,25 +19,6 @@ namespace {
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-// What an ideal full-rate panel emits for linear frame I: every frame full resolution, driven through
-// the same panel inverse and output quantisation as the decoder.
-cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits) {
-  const double levels = std::ldexp(1.0, output_bits) - 1.0;
-  cv::Mat out(linear.size(), CV_64FC3);
-  for (int y = 0; y < linear.rows; ++y) {
-    const auto* src = linear.ptr<cv::Vec3d>(y);
-    auto* dst = out.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < linear.cols; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        const double v = panel.drive_from_linear(src[x][c], c);
-        const double code = std::floor(std::clamp(v, 0.0, 1.0) * levels + 0.5);
-        dst[x][c] = panel.linear_from_drive(code / levels, c);
-      }
-    }
-  }
-  return out;
 }
 
 // Saturation / clip events of the fixed-point decoder, per stage, and its DESIGN §7 skip events (output lines).
@@ -65,28 +45,6 @@ cv::Mat preview_8bit(const cv::Mat& linear_rgb) {
 std::int64_t payload_bytes(const FrameMeta& meta) {
   const std::int64_t bits = static_cast<std::int64_t>(meta.width) * meta.height * 3 * meta.bits;
   return (bits + 7) / 8;
-}
-
-std::pair<double, double> RunRecorder::CodeAgreement::add(const cv::Mat& codes, const cv::Mat& reference_codes) {
-  cv::Mat difference;
-  cv::absdiff(codes, reference_codes, difference);
-  const cv::Mat flat = difference.reshape(1);
-  const auto samples = static_cast<std::int64_t>(flat.total());
-  const std::int64_t same = samples - cv::countNonZero(flat);
-  const double max_difference = cv::norm(flat, cv::NORM_INF);
-  compared += samples;
-  identical += same;
-  max_lsb = std::max(max_lsb, max_difference);
-  return {static_cast<double>(same) / static_cast<double>(samples), max_difference};
-}
-
-double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b) {
-  const cv::Mat a = to_encoded(linear_a, Transfer::Srgb);
-  const cv::Mat b = to_encoded(linear_b, Transfer::Srgb);
-  const double sq = cv::norm(a, b, cv::NORM_L2SQR);
-  const double mse = sq / static_cast<double>(a.total() * a.channels());
-  if (mse == 0.0) return std::numeric_limits<double>::infinity();
-  return 10.0 * std::log10(1.0 / mse);
 }
 
 JsonLinesWriter::JsonLinesWriter(const std::filesystem::path& path) : path_(path), file_(path) {}
@@ -160,19 +118,20 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     have_fixed_counts_ = true;
   }
   if (view.reference) {
-    const auto [identical, max_lsb] = vs_reference_.add(d.drive_codes, view.reference->drive_codes);
-    rec["vs_reference"] = {{"identical_fraction", identical}, {"max_lsb", max_lsb}};
+    const CodeAgreement agreement = compare_codes(d.drive_codes, view.reference->drive_codes);
+    vs_reference_ += agreement;
+    rec["vs_reference"] = {{"identical_fraction", agreement.identical_fraction()}, {"max_lsb", agreement.max_lsb}};
     if (panel_.has_history()) rec["vs_reference"]["panel_history"] = "synchronised";
   }
   if (view.free_running_reference) {
-    const auto [identical, max_lsb] = vs_free_running_.add(d.drive_codes, view.free_running_reference->drive_codes);
-    const cv::Mat merged = panel_.lcd.merged_of_emission(d.emitted_linear);
-    const cv::Mat merged_reference = panel_.lcd.merged_of_emission(view.free_running_reference->emitted_linear);
-    const double merge_codes =
-        cv::norm(merged, merged_reference, cv::NORM_INF) * ((1 << options_.output_bits) - 1);
-    vs_free_running_.max_merge_codes = std::max(vs_free_running_.max_merge_codes, merge_codes);
-    rec["vs_free_running_reference"] = {
-        {"identical_fraction", identical}, {"max_lsb", max_lsb}, {"max_merge_difference_codes", merge_codes}};
+    const CodeAgreement agreement = compare_codes(d.drive_codes, view.free_running_reference->drive_codes);
+    vs_free_running_ += agreement;
+    const double merge_codes = max_merge_difference_codes(
+        d.emitted_linear, view.free_running_reference->emitted_linear, panel_.lcd, options_.output_bits);
+    max_free_running_merge_codes_ = std::max(max_free_running_merge_codes_, merge_codes);
+    rec["vs_free_running_reference"] = {{"identical_fraction", agreement.identical_fraction()},
+                                        {"max_lsb", agreement.max_lsb},
+                                        {"max_merge_difference_codes", merge_codes}};
   }
   rec["seconds"] = {{"render", view.render_seconds}, {"encode", view.encode_seconds}, {"decode", view.decode_seconds}};
   sum_render_ += view.render_seconds;
@@ -183,9 +142,9 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   EyeHistory& eye = eyes_[meta.eye];
   cv::Mat perceived;
   if (meta.index % 2 == 1 && eye.index == meta.index - 1) {
-    perceived = panel_.perceived_pair(eye.emitted, d.emitted_linear);
+    perceived = perceived_pair(panel_, eye.emitted, d.emitted_linear);
     last_reference_pair_ = perceived_pair(eye.reference, reference);
-    const double psnr = psnr_encoded(perceived, last_reference_pair_);
+    const double psnr = psnr_srgb(perceived, last_reference_pair_);
     const double max_abs = cv::norm(perceived, last_reference_pair_, cv::NORM_INF);
     Json pair;
     pair["t"] = {meta.index - 1, meta.index};
@@ -246,14 +205,15 @@ Json RunRecorder::report(double wall_seconds) const {
   if (vs_reference_.compared > 0) {
     s["vs_reference"] = {{"codes_compared", vs_reference_.compared},
                          {"identical_fraction", vs_reference_.identical_fraction()},
-                         {"max_lsb", vs_reference_.max_lsb}};
+                         {"max_lsb", vs_reference_.max_lsb},
+                         {"meets_criterion", kReferenceAgreementCriterion.met_by(vs_reference_)}};
     if (panel_.has_history()) s["vs_reference"]["panel_history"] = "synchronised";
   }
   if (vs_free_running_.compared > 0) {
     s["vs_free_running_reference"] = {{"codes_compared", vs_free_running_.compared},
                                       {"identical_fraction", vs_free_running_.identical_fraction()},
                                       {"max_lsb", vs_free_running_.max_lsb},
-                                      {"max_merge_difference_codes", vs_free_running_.max_merge_codes}};
+                                      {"max_merge_difference_codes", max_free_running_merge_codes_}};
   }
   if (have_fixed_counts_) {
     s["fixed_point_events"] = events_json(fixed_totals_);
@@ -301,13 +261,14 @@ std::string RunRecorder::summary_table() const {
     row(("decoder " + options_.method_impl() + " vs reference").c_str(),
         fmt("%.4f %% of codes identical", 100.0 * vs_reference_.identical_fraction()) +
             fmt(", max %.0f LSB", vs_reference_.max_lsb) +
-            (panel_.has_history() ? " (panel history synchronised)" : ""));
+            (panel_.has_history() ? " (panel history synchronised)" : "") +
+            (kReferenceAgreementCriterion.met_by(vs_reference_) ? "; meets" : "; misses") + " DESIGN §6");
   }
   if (vs_free_running_.compared > 0) {
     row("  free-running (own LCD history)",
         fmt("%.4f %% identical", 100.0 * vs_free_running_.identical_fraction()) +
             fmt(", max %.0f LSB", vs_free_running_.max_lsb) +
-            fmt(", merge M within %.3f codes", vs_free_running_.max_merge_codes));
+            fmt(", merge M within %.3f codes", max_free_running_merge_codes_));
   }
   if (have_fixed_counts_ && options_.no_skip) {
     row("lines skipped (fixed-point)", "none: full path everywhere (--no-skip)");

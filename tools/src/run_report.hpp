@@ -3,6 +3,7 @@
 #pragma once
 
 #include "trm/atomic_file.hpp"
+#include "trm/metrics.hpp"
 
 #include "pipeline.hpp"
 
@@ -76,16 +77,9 @@ class RunRecorder {
   double sum_psnr_ = 0, min_psnr_ = 1e300;
   std::int64_t finite_psnr_pairs_ = 0, exact_pairs_ = 0;
   // Fixed-point decoder against the reference beside it: output codes compared.
-  struct CodeAgreement {
-    std::int64_t compared = 0, identical = 0;
-    double max_lsb = 0.0;
-    double max_merge_codes = 0.0;  // LCD free-running: max |M_fixed - M_reference| in drive codes
-    // Adds one view; returns its {identical fraction, max LSB}.
-    std::pair<double, double> add(const cv::Mat& codes, const cv::Mat& reference_codes);
-    double identical_fraction() const { return compared ? static_cast<double>(identical) / compared : 0.0; }
-  };
   CodeAgreement vs_reference_;
   CodeAgreement vs_free_running_;  // LCD only
+  double max_free_running_merge_codes_ = 0.0;  // max |M_fixed - M_reference| in drive codes
   FixedStageCounts fixed_totals_;
   std::int64_t skip_lines_reduced_ = 0;  // output lines of reduced views with a residual (motion / residual-read skips)
   std::int64_t skip_lines_full_ = 0;     // output lines of full views (residual-write skips)
@@ -93,10 +87,6 @@ class RunRecorder {
   double sum_render_ = 0;
   double sum_pixels_rendered_ = 0, sum_pixels_sent_ = 0, sum_pixels_full_ = 0;
 };
-
-// Rough PSNR (dB) between two linear images, measured on their sRGB encodings scaled to [0, 1];
-// +inf when identical.
-double psnr_encoded(const cv::Mat& linear_a, const cv::Mat& linear_b);
 
 // Prints a progress line to stderr once the run has taken more than two seconds.
 class Progress {

@@ -1,12 +1,14 @@
 // `trm sweep` (DESIGN §7, error against run time): every approximation knob of the fixed-point decoder swept alone
 // around the base configuration (the default formats plus the shared options), each point decoding the same encoded
 // sequence with the streaming decoder and held to the double-precision reference: output-code and linear-light error,
-// decode time per frame, and the on-chip / off-chip memory of FixedStreamingDecoder::report().
+// decode time per frame, and the on-chip / off-chip memory of FixedStreamingDecoder::report(). The points are
+// written out by sweep_report.hpp.
 #pragma once
 
 #include "pipeline.hpp"
 
 #include "trm/fixed_decoder.hpp"
+#include "trm/metrics.hpp"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -52,10 +54,6 @@ struct SweepOptions {
   void validate() const;
 };
 
-// The acceptance criterion of DESIGN §6 applied to each point.
-inline constexpr double kSweepIdenticalPercent = 99.9;
-inline constexpr double kSweepMaxLsb = 1.0;
-
 struct SweepPoint {
   int value = 0;
   bool is_default = false;
@@ -90,7 +88,7 @@ struct SweepPoint {
 
   bool ok() const { return status == "ok"; }
   bool meets_criterion() const {
-    return ok() && identical_percent >= kSweepIdenticalPercent && max_lsb <= kSweepMaxLsb;
+    return ok() && kReferenceAgreementCriterion.met_by(codes - differing, codes, max_lsb);
   }
 };
 
@@ -119,16 +117,5 @@ struct SweepResult {
 // FixedStreamingDecoder. progress(done, total) is called after every decode of the sequence.
 SweepResult run_sweep(const SweepOptions& options,
                       const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
-
-// sweep.csv: a header and one row per knob x value.
-std::string sweep_csv(const SweepResult& result);
-// sweep.md: parameters, a summary per knob, then one table per knob (the base value marked).
-std::string sweep_markdown(const SweepResult& result);
-// report.json: parameters, base configuration and every point.
-Json sweep_json(const SweepResult& result);
-// sweep_<knob>.png: error against knob value, against memory and against decode time (RGB).
-cv::Mat sweep_plot(const SweepResult& result, const SweepKnobResult& knob);
-// The short table printed to stdout: per knob, the base point and the cheapest point meeting the criterion.
-std::string sweep_summary(const SweepResult& result);
 
 }  // namespace trm::cli

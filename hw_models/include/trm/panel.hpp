@@ -98,9 +98,6 @@ struct Panel {
   double linear_from_drive(double v, int channel) const;
   // Its inverse: the drive that holds x (clamped to [0, 1]).
   double drive_from_linear(double x, int channel) const;
-  // What the eye sees over a frame pair from the emission of its two frames: the Talbot-Plateau average, or, for a
-  // panel whose emission already merges the pair (LCD), the second frame's emission.
-  cv::Mat perceived_pair(const cv::Mat& first_emitted, const cv::Mat& second_emitted) const;
 
   // Throws std::invalid_argument with `what` and the broken rule (see validate_panel).
   void validate(const std::string& what) const;
@@ -153,8 +150,5 @@ void to_json(nlohmann::ordered_json& out, const Panel& panel);
 // breaks validate_panel's rules.
 void from_json(const nlohmann::json& in, Panel& panel);
 void from_json(const nlohmann::ordered_json& in, Panel& panel);
-
-// Talbot-Plateau: the eye sees the time average of linear light over a pair.
-cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b);
 
 }  // namespace trm

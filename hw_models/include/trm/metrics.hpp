@@ -1,0 +1,84 @@
+// Metrics (DESIGN §6 "What correct means", §7): what the viewer sees against what full-rate rendering would show,
+// and how closely a decoder's output codes agree with the double-precision reference's. Each metric is a function
+// over cv::Mat (or a running record of them) so that reports, the sweep and the tests measure with the same code.
+#pragma once
+
+#include "trm/panel.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+
+namespace trm {
+
+// ---- light the eye sees ----
+
+// Talbot-Plateau: the eye sees the time average of linear light over a pair.
+cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b);
+
+// The pair frames t-1 and t make on `panel`, from the light it emitted in each. OLED: their Talbot-Plateau average.
+// LCD: the emission of frame t, which the merge M(v_t, v_{t-1}) (Eq. 7) already makes the pair's.
+cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, const cv::Mat& emitted);
+
+// What `panel` emits for the linear frame (CV_64FC3, [0, 1]) when every frame is rendered and shown at full
+// resolution: the double-precision drive of each value, rounded to output_bits like any decoder's, emitted back.
+// The pair of two such frames is the full-rate reference a reduced-rate method's perceived pair is held to.
+cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits);
+
+// PSNR in dB (peak 1) of two linear-light images measured on their sRGB encodings, where equal steps are about
+// equally visible; +inf when the encodings are identical.
+double psnr_srgb(const cv::Mat& linear_a, const cv::Mat& linear_b);
+
+// ---- output codes against the reference ----
+
+// Drive codes of a decoder against the reference's (rounded to the same output depth), over one or many views.
+struct CodeAgreement {
+  std::int64_t compared = 0;   // codes: pixels x channels
+  std::int64_t identical = 0;
+  double max_lsb = 0.0;        // max |Δ| in output LSB
+  double sum_lsb = 0.0;        // Σ |Δ|
+  double sum_squared_lsb = 0.0;
+
+  std::int64_t differing() const { return compared - identical; }
+  double identical_fraction() const;  // 0 when nothing was compared
+  double identical_percent() const;
+  double mean_lsb() const;
+  double rms_lsb() const;
+  // Adds the codes of further views.
+  CodeAgreement& operator+=(const CodeAgreement& other);
+};
+
+// One view's codes (any integer type, any number of channels, same size and type as reference_codes). Throws
+// std::invalid_argument when the two do not match.
+CodeAgreement compare_codes(const cv::Mat& codes, const cv::Mat& reference_codes);
+
+// LCD: the largest difference of the merge M(v_t, v_{t-1}) (Eq. 7) the eye sees, recovered from two emissions of
+// the panel (luminance M^gamma), in output codes. Codes may differ by a few LSB while M stays within one code (a
+// difference in v_{t-1} is answered by the opposite one in v_t), so this is what free-running LCD decoders are
+// compared on.
+double max_merge_difference_codes(const cv::Mat& emitted_linear, const cv::Mat& reference_emitted_linear,
+                                  const LcdPanel& lcd, int output_bits);
+
+// How closely output codes must agree with the reference: at least min_identical_fraction of them identical, none
+// more than max_lsb away.
+struct AgreementCriterion {
+  double min_identical_fraction = 1.0;
+  double max_lsb = 0.0;
+
+  constexpr double min_identical_percent() const { return 100.0 * min_identical_fraction; }
+  // `identical` of `compared` codes, the largest difference max_difference_lsb. An empty comparison fails.
+  constexpr bool met_by(std::int64_t identical, std::int64_t compared, double max_difference_lsb) const {
+    return compared > 0 &&
+           static_cast<double>(identical) / static_cast<double>(compared) >= min_identical_fraction &&
+           max_difference_lsb <= max_lsb;
+  }
+  constexpr bool met_by(const CodeAgreement& agreement) const {
+    return met_by(agreement.identical, agreement.compared, agreement.max_lsb);
+  }
+};
+
+// DESIGN §6: at the default formats the fixed-point decoder leaves at least 99.9 % of its output codes identical to
+// the reference rounded to the output depth, the rest within 1 LSB.
+inline constexpr AgreementCriterion kReferenceAgreementCriterion{0.999, 1.0};
+
+}  // namespace trm

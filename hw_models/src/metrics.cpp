@@ -1,0 +1,102 @@
+// Metrics over images (DESIGN §6, §7).
+#include "trm/metrics.hpp"
+
+#include "trm/transfer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace trm {
+
+cv::Mat perceived_pair(const cv::Mat& linear_a, const cv::Mat& linear_b) {
+  if (linear_a.size() != linear_b.size() || linear_a.type() != linear_b.type() || linear_a.depth() != CV_64F) {
+    throw std::invalid_argument("perceived_pair: the two frames must be CV_64F of the same size and channels");
+  }
+  cv::Mat sum = linear_a + linear_b;
+  return sum * 0.5;
+}
+
+cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, const cv::Mat& emitted) {
+  return panel.has_history() ? emitted.clone() : perceived_pair(emitted_previous, emitted);
+}
+
+cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits) {
+  const double levels = std::ldexp(1.0, output_bits) - 1.0;
+  cv::Mat out(linear.size(), CV_64FC3);
+  for (int y = 0; y < linear.rows; ++y) {
+    const auto* src = linear.ptr<cv::Vec3d>(y);
+    auto* dst = out.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < linear.cols; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = panel.drive_from_linear(src[x][c], c);
+        const double code = std::floor(std::clamp(v, 0.0, 1.0) * levels + 0.5);
+        dst[x][c] = panel.linear_from_drive(code / levels, c);
+      }
+    }
+  }
+  return out;
+}
+
+double psnr_srgb(const cv::Mat& linear_a, const cv::Mat& linear_b) {
+  const cv::Mat a = to_encoded(linear_a, Transfer::Srgb);
+  const cv::Mat b = to_encoded(linear_b, Transfer::Srgb);
+  const double sq = cv::norm(a, b, cv::NORM_L2SQR);
+  const double mse = sq / static_cast<double>(a.total() * a.channels());
+  if (mse == 0.0) return std::numeric_limits<double>::infinity();
+  return 10.0 * std::log10(1.0 / mse);
+}
+
+double CodeAgreement::identical_fraction() const {
+  return compared > 0 ? static_cast<double>(identical) / static_cast<double>(compared) : 0.0;
+}
+
+double CodeAgreement::identical_percent() const {
+  return compared > 0 ? 100.0 * static_cast<double>(identical) / static_cast<double>(compared) : 0.0;
+}
+
+double CodeAgreement::mean_lsb() const { return compared > 0 ? sum_lsb / static_cast<double>(compared) : 0.0; }
+
+double CodeAgreement::rms_lsb() const {
+  return compared > 0 ? std::sqrt(sum_squared_lsb / static_cast<double>(compared)) : 0.0;
+}
+
+CodeAgreement& CodeAgreement::operator+=(const CodeAgreement& other) {
+  compared += other.compared;
+  identical += other.identical;
+  max_lsb = std::max(max_lsb, other.max_lsb);
+  sum_lsb += other.sum_lsb;
+  sum_squared_lsb += other.sum_squared_lsb;
+  return *this;
+}
+
+CodeAgreement compare_codes(const cv::Mat& codes, const cv::Mat& reference_codes) {
+  if (codes.size() != reference_codes.size() || codes.type() != reference_codes.type() ||
+      codes.depth() == CV_32F || codes.depth() == CV_64F) {
+    throw std::invalid_argument("compare_codes: the two code images must be integer images of one size and type");
+  }
+  cv::Mat difference;
+  cv::absdiff(codes, reference_codes, difference);
+  CodeAgreement a;
+  if (difference.empty()) return a;
+  cv::Mat flat;
+  difference.reshape(1).convertTo(flat, CV_64F);
+  a.compared = static_cast<std::int64_t>(flat.total());
+  a.identical = a.compared - cv::countNonZero(flat);
+  a.max_lsb = cv::norm(flat, cv::NORM_INF);
+  a.sum_lsb = cv::sum(flat)[0];
+  a.sum_squared_lsb = cv::norm(flat, cv::NORM_L2SQR);
+  return a;
+}
+
+double max_merge_difference_codes(const cv::Mat& emitted_linear, const cv::Mat& reference_emitted_linear,
+                                  const LcdPanel& lcd, int output_bits) {
+  cv::Mat merged;
+  cv::Mat merged_reference;
+  cv::pow(emitted_linear, 1.0 / lcd.gamma, merged);
+  cv::pow(reference_emitted_linear, 1.0 / lcd.gamma, merged_reference);
+  return cv::norm(merged, merged_reference, cv::NORM_INF) * ((1 << output_bits) - 1);
+}
+
+}  // namespace trm
