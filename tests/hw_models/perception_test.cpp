@@ -273,6 +273,8 @@ TEST(VisualDifference, SwappingTheRenderingsChangesNothing) {
   const double ab = visual_difference_energy(a, b, 30.0, 90.0, 1.2);
   EXPECT_GT(ab, 0.0);
   EXPECT_EQ(visual_difference_energy(b, a, 30.0, 90.0, 1.2), ab);
+  // Eq. 1 is a contrast: the same renderings at a quarter of the light differ as much.
+  EXPECT_NEAR(visual_difference_energy(0.25 * a, 0.25 * b, 30.0, 90.0, 1.2), ab, 1e-12 * ab);
 }
 
 // A static grating C = a sin(2π ρ0 x) on DFT bins ±k0 is an eigenfunction of Eq. 2 with eigenvalue

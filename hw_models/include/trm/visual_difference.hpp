@@ -12,7 +12,9 @@
 //
 // In Eq. 2, ν is the temporal frequency of a grating travelling towards +x, cos 2π(ρx − νt): a grating of the
 // target frame at (ρ, ν) is, on the retina, cos 2π(ρ x_ret − (ν + ρ v_r) t), so it flickers at ν + ρ v_r there.
-// S_st is csf_spatiotemporal (Kelly-Daly, csf.hpp), which depends on |ρ| and |ν + ρ v_r| only.
+// S_st is csf_spatiotemporal (Kelly-Daly, csf.hpp), which depends on |ρ| and |ν + ρ v_r| only. It is 0 at ρ = 0,
+// so a difference uniform along the whole line (the ρ = 0 column, at any ν) adds nothing: full-field flicker needs
+// its own measure.
 //
 // The transform is OpenCV's 2-D DFT over the whole image, so the image is one period in x and in t (pad it if its
 // edges must not wrap). DFT bin (m, k) (row m, column k) holds e^{+2πi(ρ_k x + ν'_m t)} with ρ_k = k·ppd/N,
