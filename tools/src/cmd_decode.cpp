@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "output_dir.hpp"
 #include "link_report.hpp"
+#include "capture_replay.hpp"
 #include "pipeline.hpp"
 #include "run_report.hpp"
 

@@ -2,6 +2,7 @@
 // bulk (libusb), HID (hidapi) or into a file holding exactly the bytes such a device would receive.
 // The wire protocol, the HID framing and every error are described in docs/rig_protocol.md.
 #include "commands.hpp"
+#include "capture_replay.hpp"
 #include "pipeline.hpp"
 #include "rig/device_list.hpp"
 #include "rig/feeder.hpp"

@@ -8,29 +8,6 @@
 
 namespace trm::cli {
 
-FixedDecoderConfig fixed_config_of(const PipelineOptions& options) {
-  FixedDecoderConfig config;
-  config.decoder.link = options.encoder;
-  config.decoder.sensitivity = options.sensitivity;
-  config.decoder.panel = options.panel;
-  config.decoder.output_bits = options.output_bits;
-  config.decoder.lcd_history = options.lcd_history;
-  config.skip_unneeded = !options.no_skip;
-  if (options.residual_bits != 0) config.residual = residual_format_of_bits(options.residual_bits, config.linear_frac_bits);
-  return config;
-}
-
-fx::RuntimeFormat residual_format_of_bits(int bits, int linear_frac_bits) {
-  const int highest = std::min(32, 2 + linear_frac_bits);
-  if (bits < 3 || bits > highest) {
-    throw std::invalid_argument("--residual-bits " + std::to_string(bits) + " is out of range: the residual store is "
-                                "sQ2.(N - 2) (rho in [-1, 1] needs a sign and an integer bit, at most " +
-                                std::to_string(linear_frac_bits) + " fraction bits), so N must be in [3, " +
-                                std::to_string(highest) + "]");
-  }
-  return fx::RuntimeFormat{2, bits - 2, true, fx::Quant::Rnd, fx::Overflow::Sat};
-}
-
 namespace {
 
 bool on_chip(const FixedBufferReport& b) { return b.name.rfind("line:", 0) == 0; }

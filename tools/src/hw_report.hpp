@@ -14,14 +14,6 @@ namespace trm::cli {
 
 using Json = nlohmann::ordered_json;
 
-// The decoder configuration of the shared pipeline options (link, sensitivity, panel, output bits, LCD history)
-// with the default fixed-point formats.
-FixedDecoderConfig fixed_config_of(const PipelineOptions& options);
-
-// Residual store of total signed width `bits` (sQ2.(bits - 2)); throws std::invalid_argument outside
-// [3, 2 + linear_frac_bits] (and 32).
-fx::RuntimeFormat residual_format_of_bits(int bits, int linear_frac_bits);
-
 // Buffers, ROMs, arithmetic per stage, latency, on-/off-chip totals and the paper's frame-store comparison.
 Json hardware_json(const FixedStreamingReport& report);
 // A human-readable summary of hardware_json's content.

@@ -1,5 +1,6 @@
 #include "sweep_report.hpp"
 
+#include "trm/encoder_json.hpp"
 #include "trm/metrics.hpp"
 
 #include <opencv2/imgproc.hpp>
@@ -371,12 +372,8 @@ Json sweep_json(const SweepResult& r) {
                      {"size", {r.size.width, r.size.height}},
                      {"reduced_size", {r.reduced.width, r.reduced.height}},
                      {"views", r.views},
-                     {"reduction", po.encoder.reduction},
-                     {"sigma", po.encoder.effective_sigma()},
-                     {"transfer", to_string(po.encoder.transfer)},
-                     {"link_bits", po.encoder.bits},
+                     {"encoder", encoder_json(po.encoder)},
                      {"output_bits", po.output_bits},
-                     {"stereo", po.encoder.stereo},
                      {"sensitivity", po.sensitivity},
                      {"panel", po.panel},
                      {"seed", po.seed},
