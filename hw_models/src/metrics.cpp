@@ -90,6 +90,22 @@ CodeAgreement compare_codes(const cv::Mat& codes, const cv::Mat& reference_codes
   return a;
 }
 
+std::optional<PairTracker::Pair> PairTracker::add(int eye, std::int64_t t, const cv::Mat& emitted,
+                                                  const cv::Mat& reference_emitted) {
+  Previous& previous = previous_[eye];
+  std::optional<Pair> pair;
+  if (t % 2 == 1 && previous.t == t - 1) {
+    pair.emplace();
+    pair->first = t - 1;
+    pair->perceived = perceived_pair(panel_, previous.emitted, emitted);
+    pair->reference = perceived_pair(previous.reference, reference_emitted);
+  }
+  previous.t = t;
+  previous.emitted = emitted;
+  previous.reference = reference_emitted;
+  return pair;
+}
+
 double max_merge_difference_codes(const cv::Mat& emitted_linear, const cv::Mat& reference_emitted_linear,
                                   const LcdPanel& lcd, int output_bits) {
   cv::Mat merged;

@@ -56,6 +56,7 @@ void JsonLinesWriter::close() { file_.commit(); }
 RunRecorder::RunRecorder(const PipelineOptions& options, const std::filesystem::path& directory)
     : options_(options),
       panel_(options.panel),
+      pairs_tracker_(options.panel),
       view_records_(directory / "views.jsonl"),
       pair_records_(directory / "pairs.jsonl") {}
 
@@ -139,19 +140,18 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   ++views_;
 
   const cv::Mat reference = full_rate_emission(*view.linear_full, panel_, options_.output_bits);
-  EyeHistory& eye = eyes_[meta.eye];
   cv::Mat perceived;
-  if (meta.index % 2 == 1 && eye.index == meta.index - 1) {
-    perceived = perceived_pair(panel_, eye.emitted, d.emitted_linear);
-    last_reference_pair_ = perceived_pair(eye.reference, reference);
+  if (const auto pair = pairs_tracker_.add(meta.eye, meta.index, d.emitted_linear, reference)) {
+    perceived = pair->perceived;
+    last_reference_pair_ = pair->reference;
     const double psnr = psnr_srgb(perceived, last_reference_pair_);
     const double max_abs = cv::norm(perceived, last_reference_pair_, cv::NORM_INF);
-    Json pair;
-    pair["t"] = {meta.index - 1, meta.index};
-    pair["eye"] = meta.eye;
-    pair["psnr_db"] = json_number(psnr);
-    pair["max_abs_linear"] = max_abs;
-    pair_records_.write(pair);
+    Json record;
+    record["t"] = {pair->first, meta.index};
+    record["eye"] = meta.eye;
+    record["psnr_db"] = json_number(psnr);
+    record["max_abs_linear"] = max_abs;
+    pair_records_.write(record);
     ++pairs_;
     if (std::isfinite(psnr)) {
       sum_psnr_ += psnr;
@@ -161,9 +161,6 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
       ++exact_pairs_;
     }
   }
-  eye.emitted = d.emitted_linear;
-  eye.reference = reference;
-  eye.index = meta.index;
   return perceived;
 }
 

@@ -58,17 +58,12 @@ class RunRecorder {
   int full_height() const { return full_height_; }
 
  private:
-  struct EyeHistory {
-    cv::Mat emitted;     // emitted linear light of the previous frame of this eye
-    cv::Mat reference;   // full-rate reference emission of the previous frame
-    std::int64_t index = -1;
-  };
   PipelineOptions options_;
   Panel panel_;
+  PairTracker pairs_tracker_;
   JsonLinesWriter view_records_;
   JsonLinesWriter pair_records_;
   std::int64_t views_ = 0, pairs_ = 0;
-  std::map<int, EyeHistory> eyes_;
   cv::Mat last_reference_pair_;
   int full_width_ = 0, full_height_ = 0, reduced_width_ = 0, reduced_height_ = 0;
   double sum_full_payload_ = 0, sum_payload_ = 0;

@@ -8,6 +8,8 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <map>
+#include <optional>
 
 namespace trm {
 
@@ -24,6 +26,28 @@ cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, cons
 // resolution: the double-precision drive of each value, rounded to output_bits like any decoder's, emitted back.
 // The pair of two such frames is the full-rate reference a reduced-rate method's perceived pair is held to.
 cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits);
+
+// Frame pairs as the eye sees them at a fixed gaze, per eye. Views come in slot order with their emitted light and
+// the full-rate reference's emission (full_rate_emission of the scene at that t); a view that completes a pair
+// (frames 2k and 2k + 1 of one eye) returns the perceived pair and the full-rate reference pair.
+class PairTracker {
+ public:
+  explicit PairTracker(Panel panel) : panel_(std::move(panel)) {}
+  struct Pair {
+    std::int64_t first = 0;  // t of the pair's first frame
+    cv::Mat perceived;
+    cv::Mat reference;
+  };
+  std::optional<Pair> add(int eye, std::int64_t t, const cv::Mat& emitted, const cv::Mat& reference_emitted);
+
+ private:
+  struct Previous {
+    std::int64_t t = -1;
+    cv::Mat emitted, reference;
+  };
+  Panel panel_;
+  std::map<int, Previous> previous_;
+};
 
 // PSNR in dB (peak 1) of two linear-light images measured on their sRGB encodings, where equal steps are about
 // equally visible; +inf when the encodings are identical.

@@ -1,0 +1,59 @@
+// `trm compare`: every display method on the same frames, through the same link and panel, measured with the same
+// metrics (the paper's Table 1 with measured columns).
+#pragma once
+
+#include "options.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace trm::cli {
+
+struct CompareOptions {
+  PipelineOptions pipeline;          // scene, size, frames, encoder, panel, link; --method and --impl do not apply
+  std::vector<std::string> methods;  // NAME or NAME:OPTION; empty: every registered method
+  // Throws std::invalid_argument with one clear message (an unknown method, one named twice, bad shared options).
+  void validate() const;
+  // The methods compared, in order: the asked ones, or every registered method.
+  std::vector<std::string> chosen_methods() const;
+};
+
+// What one method measured. Fractions and percentages are against full-rate rendering of the same frames.
+struct MethodMeasure {
+  std::string method;
+  std::int64_t views = 0;
+  double pixels_rendered_saved_percent = 0.0;   // 100 (1 - rendered / full rate)
+  double pixels_sent_saved_percent = 0.0;       // 100 (1 - sent / full rate)
+  double mean_link_payload_bits = 0.0;          // per link frame
+  std::uint64_t peak_link_wire_bits = 0;
+  bool link_fits = true;
+  double luminance_percent = 0.0;               // mean emitted luma against the full-rate emission's
+  double flicker_contrast = 0.0;                // mean |Y_2k - Y_2k+1| / (Y_2k + Y_2k+1) over pixels and pairs
+  double reference_flicker_contrast = 0.0;      // the same of the full-rate emission (motion alone alternates too)
+  double mtcd = 0.0;                            // Kim et al. Eq. 6 on the emitted light's 8-bit sRGB encoding
+  double reference_mtcd = 0.0;
+  double mean_pair_psnr_db = 0.0;               // fixed gaze, against the full-rate reference pair; +inf: exact
+  std::int64_t pairs = 0;
+  double seconds = 0.0;                         // wall time of this method's run
+};
+
+struct CompareResult {
+  CompareOptions options;
+  cv::Size size;
+  std::vector<MethodMeasure> methods;
+};
+
+// Runs every chosen method in turn; progress(done, total) after each view (total views over all methods).
+CompareResult run_compare(const CompareOptions& options,
+                          const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
+
+// The table as the terminal shows it, as Markdown, as CSV (one row per method) and as JSON.
+std::string compare_table(const CompareResult& result);
+std::string compare_markdown(const CompareResult& result);
+std::string compare_csv(const CompareResult& result);
+nlohmann::ordered_json compare_json(const CompareResult& result);
+
+}  // namespace trm::cli
