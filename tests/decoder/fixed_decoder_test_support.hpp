@@ -196,14 +196,12 @@ inline Agreement compare_with_reference(const std::vector<LinkFrame>& frames, co
     agreement.concealed_lines += got_frame.stats.concealed_lines;
     const cv::Mat& expected = expected_frame.drive_codes;
     const cv::Mat& got = got_frame.drive_codes;
-    if (config.decoder.panel.kind == PanelKind::Lcd) {
+    if (config.decoder.panel.has_history()) {
       agreement.max_unreachable_difference =
           std::max(agreement.max_unreachable_difference, std::abs(expected_frame.stats.lcd_unreachable_fraction -
                                                                   got_frame.stats.lcd_unreachable_fraction));
-      cv::Mat merged_expected;
-      cv::Mat merged_got;
-      cv::pow(expected_frame.emitted_linear, 1.0 / config.decoder.panel.lcd.gamma, merged_expected);
-      cv::pow(got_frame.emitted_linear, 1.0 / config.decoder.panel.lcd.gamma, merged_got);
+      const cv::Mat merged_expected = config.decoder.panel.lcd.merged_of_emission(expected_frame.emitted_linear);
+      const cv::Mat merged_got = config.decoder.panel.lcd.merged_of_emission(got_frame.emitted_linear);
       agreement.max_merged_codes =
           std::max(agreement.max_merged_codes, cv::norm(merged_expected, merged_got, cv::NORM_INF) *
                                                    ((1 << config.decoder.output_bits) - 1));
