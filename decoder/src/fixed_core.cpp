@@ -1,7 +1,6 @@
 // The state and plumbing both fixed-point schedules share (fixed_core.hpp): eye states, output, LCD frame stores,
 // the per-pixel full and reduced frame steps, skip gates, stage taps and statistics.
 #include "fixed_core.hpp"
-#include "lost_view.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -242,7 +241,7 @@ detail::Arrival FixedDecoderCore::classify(const LinkFrame& frame, std::span<con
 }
 
 DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
-  check_view_meta(meta, std::string(who).append(": lost view: "));
+  detail::check_lost_view(meta, who);
   last_counts_ = FixedStageCounts();
   return detail::hold_lost_view(eyes_[meta.eye], meta);
 }

@@ -9,7 +9,6 @@
 // Then the panel inverse (Sec. 4.4): OLED v = x^(1/gamma_c); LCD solves Eq. 7 for v_t given v_{t-1}.
 #include "trm/reference_decoder.hpp"
 
-#include "lost_view.hpp"
 #include "view_arrival.hpp"
 
 #include "trm/resample.hpp"
@@ -329,35 +328,14 @@ void DecoderConfig::validate() const {
     throw std::invalid_argument("DecoderConfig: output_bits must be 8 or 10 (got " + std::to_string(output_bits) +
                                 ")");
   }
-  validate_panel(panel, "DecoderConfig: ");
+  panel.validate("DecoderConfig: ");
 }
 
 ReferenceDecoder::ReferenceDecoder(DecoderConfig config)
     : config_((config.validate(), std::move(config))), emission_(config_.panel, config_.output_bits) {}
 
-DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
-  const cv::Size full(meta.full_width, meta.full_height);
-  DecodedFrame out;
-  if (last != nullptr) {
-    out = *last;
-    out.stages.reset();
-  } else {
-    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
-    out.drive = cv::Mat::zeros(full, CV_64FC3);
-    out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
-    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
-  }
-  out.meta = meta;
-  out.meta.width = full.width;
-  out.meta.height = full.height;
-  out.stats = FrameStats();
-  out.stats.frame_lost = true;
-  out.stats.concealed_lines = meta.height;
-  return out;
-}
-
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
-  check_view_meta(meta, std::string("ReferenceDecoder: lost ").append(detail::frame_name(meta)).append(": "));
+  detail::check_lost_view(meta, "ReferenceDecoder");
   return detail::hold_lost_view(eyes_[meta.eye], meta);
 }
 

@@ -1,4 +1,5 @@
-// The input checks and the concealment classification every decoder shares (view_arrival.hpp).
+// The input checks, the concealment classification and the lost-view output every decoder shares
+// (view_arrival.hpp).
 #include "view_arrival.hpp"
 
 #include "trm/resample.hpp"
@@ -58,6 +59,10 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
   }
 }
 
+void check_lost_view(const FrameMeta& meta, const std::string& who) {
+  check_view_meta(meta, who + ": lost " + frame_name(meta) + ": ");
+}
+
 Arrival classify_arrival(const LinkFrame& frame, std::span<const std::uint8_t> line_intact, Concealment& out,
                          const std::string& who) {
   if (line_intact.empty()) return Arrival::Whole;
@@ -96,3 +101,28 @@ cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c) {
 }
 
 }  // namespace trm::detail
+
+namespace trm {
+
+DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
+  const cv::Size full(meta.full_width, meta.full_height);
+  DecodedFrame out;
+  if (last != nullptr) {
+    out = *last;
+    out.stages.reset();
+  } else {
+    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
+    out.drive = cv::Mat::zeros(full, CV_64FC3);
+    out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
+    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
+  }
+  out.meta = meta;
+  out.meta.width = full.width;
+  out.meta.height = full.height;
+  out.stats = FrameStats();
+  out.stats.frame_lost = true;
+  out.stats.concealed_lines = meta.height;
+  return out;
+}
+
+}  // namespace trm

@@ -1,7 +1,7 @@
 // How a received view arrived, decided once for every decoder: the checks a view must pass before any stage runs,
-// and the classification of a line mask into a whole, partial or lost view with the concealment of a partial one
-// (DESIGN §4, README "Concealment"). The reference and both fixed-point schedules call these, so they reject the
-// same views with the same messages and conceal the same lines the same way.
+// the classification of a line mask into a whole, partial or lost view, the concealment of a partial one and what
+// a lost one shows (DESIGN §4, README "Concealment"). The reference and both fixed-point schedules call these, so
+// they reject the same views with the same messages and conceal the same lines the same way.
 #pragma once
 
 #include "trm/decoder.hpp"
@@ -19,6 +19,10 @@ std::string frame_name(const FrameMeta& meta);
 // produce: valid metadata, the link's bits and transfer, non-empty CV_16UC3 codes of the metadata's size, that size
 // the view's full or reduced size, and no code beyond the link bit depth.
 void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who);
+
+// Throws std::invalid_argument "<who>: lost <frame name>: <problem>" unless the metadata of a view that never
+// arrived is valid.
+void check_lost_view(const FrameMeta& meta, const std::string& who);
 
 // A view that arrived with some lines lost (at least one lost, at least one intact): lost lines of a full frame feed
 // D as copies of the nearest intact line above (else below) and show L_t with rho = 0; lost lines of a reduced frame
@@ -55,5 +59,24 @@ cv::Mat concealment_substitute(const EyeMap& eyes, const LinkFrame& frame) {
 
 // The codes of a partially received view with every lost line replaced (the frame-at-a-time form of the rules).
 cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c);
+
+// What every decoder does with one eye's state when a whole view is lost (over the reference's and the fixed-point
+// decoders' eye states: same member names, different sample types). The eye's previous output is shown again if it has one at this view size (else black, and the eye starts afresh
+// at the new size). The residual belonged to a pair that is now broken and is dropped with the d_t it was built
+// against; the LCD stores keep the drive the panel still shows.
+template <typename EyeState>
+DecodedFrame hold_lost_view(EyeState& eye, const FrameMeta& meta) {
+  const cv::Size full(meta.full_width, meta.full_height);
+  const bool held = eye.full_size == full && !eye.last_output.drive.empty();
+  if (!held) {
+    eye = EyeState();
+    eye.full_size = full;
+  }
+  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr);
+  eye.have_residual = false;
+  eye.residual.release();
+  eye.previous_low.release();
+  return out;
+}
 
 }  // namespace trm::detail

@@ -108,11 +108,9 @@ std::optional<PairTracker::Pair> PairTracker::add(int eye, std::int64_t t, const
 
 double max_merge_difference_codes(const cv::Mat& emitted_linear, const cv::Mat& reference_emitted_linear,
                                   const LcdPanel& lcd, int output_bits) {
-  cv::Mat merged;
-  cv::Mat merged_reference;
-  cv::pow(emitted_linear, 1.0 / lcd.gamma, merged);
-  cv::pow(reference_emitted_linear, 1.0 / lcd.gamma, merged_reference);
-  return cv::norm(merged, merged_reference, cv::NORM_INF) * ((1 << output_bits) - 1);
+  return cv::norm(lcd.merged_of_emission(emitted_linear), lcd.merged_of_emission(reference_emitted_linear),
+                 cv::NORM_INF) *
+         ((1 << output_bits) - 1);
 }
 
 }  // namespace trm

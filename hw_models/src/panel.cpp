@@ -306,7 +306,7 @@ void validate_panel(const Panel& panel, const std::string& what) { panel.validat
 Panel parse_panel(const std::string& spec) {
   Panel panel = parse_panel_spec(spec);
   try {
-    validate_panel(panel, "");
+    panel.validate("");
   } catch (const std::invalid_argument& e) {
     reject(spec, e.what());
   }
@@ -315,37 +315,49 @@ Panel parse_panel(const std::string& spec) {
 
 namespace {
 
-Panel parse_panel_spec(const std::string& spec) {
-  if (spec == "vive") return oled_panel(spec, kViveGamma);
-  if (spec == "rift") return oled_panel(spec, kRiftGamma);
-  if (spec == "generic") return oled_panel(spec, {kGenericGamma, kGenericGamma, kGenericGamma});
-
+// The OLED forms: the measured presets and gamma:G | gamma:GR,GG,GB. False when `spec` is none of them.
+bool parse_oled_spec(const std::string& spec, Panel& out) {
   const std::string_view view(spec);
-  if (view.starts_with("gamma:")) {
-    const std::vector<double> g = parse_numbers(spec, view.substr(6));
-    if (g.size() != 1 && g.size() != 3) reject(spec, "gamma: takes 1 or 3 values");
-    for (double value : g) {
-      if (!(value > 0.0)) reject(spec, "gammas must be > 0");
-    }
-    return oled_panel(spec, g.size() == 1 ? std::array<double, 3>{g[0], g[0], g[0]}
-                                          : std::array<double, 3>{g[0], g[1], g[2]});
+  if (spec == "vive" || spec == "rift" || spec == "generic") {
+    out = oled_panel(spec, spec == "vive"   ? kViveGamma
+                           : spec == "rift" ? kRiftGamma
+                                            : std::array<double, 3>{kGenericGamma, kGenericGamma, kGenericGamma});
+    return true;
   }
+  if (!view.starts_with("gamma:")) return false;
+  const std::vector<double> g = parse_numbers(spec, view.substr(6));
+  if (g.size() != 1 && g.size() != 3) reject(spec, "gamma: takes 1 or 3 values");
+  for (double value : g) {
+    if (!(value > 0.0)) reject(spec, "gammas must be > 0");
+  }
+  out = oled_panel(spec, g.size() == 1 ? std::array<double, 3>{g[0], g[0], g[0]}
+                                       : std::array<double, 3>{g[0], g[1], g[2]});
+  return true;
+}
 
+// The LCD forms: lcd (the default merge) | lcd:p1,p2,p3,p4,gamma. False when `spec` is neither.
+bool parse_lcd_spec(const std::string& spec, Panel& out) {
+  const std::string_view view(spec);
+  if (spec != "lcd" && !view.starts_with("lcd:")) return false;
+  out = Panel();
+  out.kind = PanelKind::Lcd;
+  out.name = spec;
+  if (spec == "lcd") return true;
+  const std::vector<double> p = parse_numbers(spec, view.substr(4));
+  if (p.size() != 5) reject(spec, "lcd: takes 5 values p1,p2,p3,p4,gamma");
+  if (!(p[4] > 0.0)) reject(spec, "the LCD gamma must be > 0");
+  out.lcd.p1 = p[0];
+  out.lcd.p2 = p[1];
+  out.lcd.p3 = p[2];
+  out.lcd.p4 = p[3];
+  out.lcd.gamma = p[4];
+  return true;
+}
+
+// Each panel kind parses its own forms; a new kind adds its parser here.
+Panel parse_panel_spec(const std::string& spec) {
   Panel panel;
-  panel.kind = PanelKind::Lcd;
-  panel.name = spec;
-  if (spec == "lcd") return panel;
-  if (view.starts_with("lcd:")) {
-    const std::vector<double> p = parse_numbers(spec, view.substr(4));
-    if (p.size() != 5) reject(spec, "lcd: takes 5 values p1,p2,p3,p4,gamma");
-    if (!(p[4] > 0.0)) reject(spec, "the LCD gamma must be > 0");
-    panel.lcd.p1 = p[0];
-    panel.lcd.p2 = p[1];
-    panel.lcd.p3 = p[2];
-    panel.lcd.p4 = p[3];
-    panel.lcd.gamma = p[4];
-    return panel;
-  }
+  if (parse_oled_spec(spec, panel) || parse_lcd_spec(spec, panel)) return panel;
   reject(spec, "unknown panel");
 }
 

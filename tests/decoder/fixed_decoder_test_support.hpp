@@ -183,7 +183,7 @@ inline Agreement compare_with_reference(const std::vector<LinkFrame>& frames, co
     agreement.concealed_lines += got_frame.stats.concealed_lines;
     const cv::Mat& expected = expected_frame.drive_codes;
     const cv::Mat& got = got_frame.drive_codes;
-    if (config.decoder.panel.kind == PanelKind::Lcd) {
+    if (config.decoder.panel.has_history()) {
       agreement.max_unreachable_difference =
           std::max(agreement.max_unreachable_difference, std::abs(expected_frame.stats.lcd_unreachable_fraction -
                                                                   got_frame.stats.lcd_unreachable_fraction));

@@ -51,7 +51,7 @@ CaseRun run_case(const std::vector<LinkFrame>& frames, const FixedDecoderConfig&
   FixedFrameDecoder frame_decoder(config);
   FixedStreamingDecoder streaming_decoder(config);
   ReferenceDecoder reference(config.decoder);
-  const bool lcd = config.decoder.panel.kind == PanelKind::Lcd;
+  const bool lcd = config.decoder.panel.has_history();
   CaseRun run;
   for (std::size_t n = 0; n < frames.size(); ++n) {
     const LinkFrame& frame = frames[n];

@@ -127,6 +127,36 @@ TEST(RuntimeFormat, QuantiseDoubleMatchesFixedAndRejectsNonFinite) {
   EXPECT_THROW(quantise_double(-std::numeric_limits<double>::infinity(), q2_14), std::invalid_argument);
 }
 
+// rounded_shift is the quantisation step alone: for values whose result fits, it is quantise_raw into an integer
+// format wide enough that no overflow occurs, in every rounding mode, for every sign, tie and shift (including
+// shifts <= 0, which are exact).
+TEST(RuntimeFormat, RoundedShiftIsTheQuantisationStep) {
+  std::mt19937_64 rng(2718);
+  const RuntimeFormat integer{64, 0, true, Quant::Trn, Overflow::Wrap};
+  for (const Quant q : kAllQuantModes) {
+    RuntimeFormat out = integer;
+    out.quant = q;
+    for (int shift = -4; shift <= 40; ++shift) {
+      for (int i = 0; i < 200; ++i) {
+        std::int64_t raw = static_cast<std::int64_t>(rng() >> 20) - (std::int64_t{1} << 43);
+        if (i % 4 == 0 && shift > 0) raw = (raw >> shift << shift) | (std::int64_t{1} << (shift - 1));  // exact tie
+        EXPECT_EQ(rounded_shift(raw, shift, q), quantise_raw(raw, shift, out))
+            << to_string(q) << " " << raw << " >> " << shift;
+        const detail::int128 wide = static_cast<detail::int128>(raw) << 40;
+        EXPECT_EQ(static_cast<std::int64_t>(rounded_shift(wide, shift + 40, q)), quantise_raw(raw, shift, out));
+      }
+    }
+  }
+  // Round half up and half to even, the two the decoder uses, on ties of both signs.
+  EXPECT_EQ(rounded_shift(std::int64_t{5}, 1, Quant::Rnd), 3);
+  EXPECT_EQ(rounded_shift(std::int64_t{-5}, 1, Quant::Rnd), -2);
+  EXPECT_EQ(rounded_shift(std::int64_t{5}, 1, Quant::RndConv), 2);
+  EXPECT_EQ(rounded_shift(std::int64_t{7}, 1, Quant::RndConv), 4);
+  EXPECT_EQ(rounded_shift(std::int64_t{-5}, 1, Quant::RndConv), -2);
+  EXPECT_EQ(rounded_shift(std::int64_t{-3}, 0, Quant::Rnd), -3);
+  EXPECT_EQ(rounded_shift(std::int64_t{-3}, -2, Quant::Rnd), -12);
+}
+
 TEST(RuntimeFormat, InvalidFormatsAreRejectedWithAReason) {
   const auto message_of = [](const RuntimeFormat& f) {
     try {
