@@ -1,0 +1,50 @@
+// `trm compare`: every display method on the same scene, link and panel, as the paper's Table 1 with measured
+// columns: compare.md, compare.csv and report.json in the output directory, the table on stdout.
+#include "commands.hpp"
+#include "compare.hpp"
+#include "output_dir.hpp"
+#include "run_report.hpp"
+
+#include <iostream>
+#include <memory>
+
+namespace trm::cli {
+
+void register_compare(CLI::App& app, Action& action) {
+  auto options = std::make_shared<CompareOptions>();
+  options->pipeline.default_frames = 30;
+  auto out = std::make_shared<std::string>("trm-compare");
+  CLI::App* cmd = app.add_subcommand(
+      "compare", "Run every display method (trm methods) on the same frames and compare them: pixels rendered and "
+                 "sent, link bandwidth, luminance, flicker, MTCD, pair PSNR (default: discs, 1080x1200, 30 frames)");
+  options->pipeline.add_options(*cmd);
+  options->pipeline.add_link_options(*cmd);
+  // Every method is shown by its double-precision headset side: the comparison is of methods, not decoders.
+  cmd->remove_option(cmd->get_option("--impl"));
+  cmd->add_option("--methods", options->methods, "Methods to compare, comma separated (default: every method)")
+      ->delimiter(',');
+  cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
+  cmd->callback([options, out, &action] {
+    action = [options, out] {
+      options->validate();
+      OutputDir dir(*out);
+      const std::int64_t frames = options->pipeline.frames > 0 ? options->pipeline.frames : options->pipeline.default_frames;
+      Progress progress(static_cast<std::int64_t>(options->chosen_methods().size()) * frames *
+                        (options->pipeline.encoder.stereo ? 2 : 1));
+      const CompareResult result =
+          run_compare(*options, [&](std::int64_t done, std::int64_t) { progress.update(done); });
+      progress.finish();
+      dir.write_text("compare.md", compare_markdown(result));
+      dir.write_text("compare.csv", compare_csv(result));
+      dir.write_text("report.json", compare_json(result).dump(2) + "\n");
+      dir.commit();
+      std::cout << "trm compare: " << (options->pipeline.input.empty() ? options->pipeline.scene : options->pipeline.input)
+                << ", " << result.size.width << "x" << result.size.height << ", " << frames << " frames\n"
+                << compare_table(result) << "  wrote " << dir.target().string()
+                << "/ (compare.md, compare.csv, report.json)\n";
+      return 0;
+    };
+  });
+}
+
+}  // namespace trm::cli
