@@ -550,3 +550,9 @@ void write_png(const std::filesystem::path& path, const Figure& figure) {
 }
 
 }  // namespace trm::plot
+
+#if defined(__SANITIZE_ADDRESS__)
+// Fontconfig, which pango asks for the plots' fonts, keeps its pattern caches unreferenced until the process ends;
+// LeakSanitizer would report them at exit of every program that plots.
+extern "C" const char* __lsan_default_suppressions() { return "leak:libfontconfig.so\n"; }
+#endif
