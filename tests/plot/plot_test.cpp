@@ -102,6 +102,12 @@ TEST(Plot, WritesAPngThatDecodesAtTheAskedSizeAndShowsTheData) {
   EXPECT_EQ(entries, 1);
 }
 
+TEST(Plot, WritesUnderADirectoryNameHoldingPlplotsFilePattern) {
+  const fs::path dir = fresh_dir("family %n name");
+  write_png(dir / "figure.png", two_chart_figure());
+  EXPECT_FALSE(cv::imread((dir / "figure.png").string()).empty());
+}
+
 TEST(Plot, ReplacesAnEarlierPlotWhole) {
   const fs::path dir = fresh_dir("replaces");
   const fs::path png = dir / "figure.png";

@@ -3,6 +3,7 @@
 #include "trm/plot.hpp"
 #include "trm/resample.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace trm::cli {

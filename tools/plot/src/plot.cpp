@@ -6,9 +6,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <string_view>
@@ -482,12 +486,18 @@ void render(const std::filesystem::path& file, const Figure& f) {
   try {
     require_device();
     plsdev(kDevice);
-    plsfnam(file.c_str());
+    // PLplot gets an open file, not the name: it would rewrite a name holding "%n" (its family-file pattern).
+    std::FILE* out = std::fopen(file.c_str(), "wb");
+    if (!out) throw std::runtime_error(std::string("cannot open the staging file: ") + std::strerror(errno));
+    plsfile(out);
     plspage(kPixelsPerInch, kPixelsPerInch, f.width, f.height, 0, 0);
     for (std::size_t i = 0; i < kColourMap.size(); ++i) {
       plscol0(static_cast<PLINT>(i), kColourMap[i][0], kColourMap[i][1], kColourMap[i][2]);
     }
     plinit();
+    PLINT level = 0;
+    plglevel(&level);
+    if (level == 0) std::fclose(out);  // from plinit on, PLplot closes it when the stream ends
     stream.check("to start the page");
     pladv(0);
 
@@ -524,12 +534,16 @@ void render(const std::filesystem::path& file, const Figure& f) {
   }
 }
 
-void require_png(const std::filesystem::path& file) {
+// PLplot does not report a failed write of the page (a full disk, say): a PNG is whole when it begins with the
+// signature and ends with the IEND chunk.
+void require_whole_png(const std::filesystem::path& file) {
+  constexpr std::string_view kSignature("\x89PNG\r\n\x1a\n", 8);
+  constexpr std::string_view kEnd("\0\0\0\0IEND\xae\x42\x60\x82", 12);
   std::ifstream in(file, std::ios::binary);
-  std::array<char, 8> signature{};
-  in.read(signature.data(), signature.size());
-  if (!in || std::string_view(signature.data(), signature.size()) != "\x89PNG\r\n\x1a\n") {
-    throw std::runtime_error("PLplot wrote no PNG (disk full?)");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() < kSignature.size() + kEnd.size() || !bytes.starts_with(kSignature) ||
+      !bytes.ends_with(kEnd)) {
+    throw std::runtime_error("PLplot wrote no whole PNG (" + std::to_string(bytes.size()) + " bytes; disk full?)");
   }
 }
 
@@ -542,7 +556,7 @@ void write_png(const std::filesystem::path& path, const Figure& figure) {
     std::lock_guard lock(plplot_mutex());
     plsexit(&throw_on_fatal);
     render(file.staging_path(), figure);
-    require_png(file.staging_path());
+    require_whole_png(file.staging_path());
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("cannot plot '" + io::shown(path) + "': " + e.what());
   }
