@@ -18,6 +18,9 @@ packages=(
   nlohmann-json3-dev       # report.json
   zlib1g-dev               # CRC32 for link packets
   libcharls-dev            # JPEG-LS lossless link codec
+  libplplot-dev            # the plots (PLplot)
+  plplot-driver-cairo      # PLplot's pngcairo driver, a package of its own: PNG without a display
+  fonts-dejavu-core        # the plots' text on a machine with no desktop fonts
   umockdev libumockdev-dev # emulated USB/HID devices for rig tests
   clang libclang-rt-14-dev # libFuzzer for the link receiver
 )

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -115,6 +116,39 @@ void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFra
   FramesCsvWriter writer(path, refresh_hz, method);
   for (const LinkFrameUsage& u : frames) writer.add(u);
   writer.close();
+}
+
+PlotTrace::PlotTrace(std::string label, std::size_t max_buckets) : label_(std::move(label)), max_buckets_(max_buckets) {
+  if (max_buckets_ < 2 || max_buckets_ % 2 != 0) {
+    throw std::invalid_argument("plot trace: max_buckets must be even, >= 2");
+  }
+  buckets_.reserve(max_buckets_);
+}
+
+void PlotTrace::add(double bits) {
+  const bool finite = std::isfinite(bits);
+  if (count_ % width_ == 0) {
+    if (buckets_.size() == max_buckets_) {
+      // Full: pairs of buckets become one of twice the width, which leaves count_ on a bucket boundary.
+      for (std::size_t i = 0; i < max_buckets_ / 2; ++i) {
+        const Bucket& a = buckets_[2 * i];
+        const Bucket& b = buckets_[2 * i + 1];
+        buckets_[i] = {a.first, b.last, std::min(a.min, b.min), std::max(a.max, b.max)};
+      }
+      buckets_.resize(max_buckets_ / 2);
+      width_ *= 2;
+    }
+    const double inf = std::numeric_limits<double>::infinity();
+    buckets_.push_back({bits, bits, finite ? bits : inf, finite ? bits : -inf});
+  } else {
+    Bucket& b = buckets_.back();
+    b.last = bits;
+    if (finite) {
+      b.min = std::min(b.min, bits);
+      b.max = std::max(b.max, bits);
+    }
+  }
+  ++count_;
 }
 
 }  // namespace trm::link

@@ -99,6 +99,8 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
     }
     const cv::Mat image = cv::imread(plot.string());
     EXPECT_FALSE(image.empty()) << plot;
+    EXPECT_EQ(image.cols, 1620) << plot;
+    EXPECT_EQ(image.rows, 500) << plot;
     values_of[knob.name] = knob.values.size();
     expected_rows += knob.values.size();
   }

@@ -349,7 +349,10 @@ TEST(Cli, CaptureReplaysIntoDecodeAndFeed) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   ASSERT_TRUE(fs::exists(tmp.path() / "run" / "link.trmcap"));
   ASSERT_TRUE(fs::exists(tmp.path() / "run" / "frames.csv"));
-  ASSERT_TRUE(fs::exists(tmp.path() / "run" / "link_bits.png"));
+  const cv::Mat bits_plot = cv::imread(tmp.str("run/link_bits.png"));
+  ASSERT_FALSE(bits_plot.empty());
+  EXPECT_EQ(bits_plot.cols, 1200);
+  EXPECT_EQ(bits_plot.rows, 640);
   const Result decode = run_trm("decode --capture " + tmp.str("run/link.trmcap") + " --out " + tmp.str("dec"));
   ASSERT_EQ(decode.exit_code, 0) << decode.output;
   EXPECT_TRUE(fs::exists(tmp.path() / "dec" / "drive8_0003.png"));

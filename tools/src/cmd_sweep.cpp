@@ -109,7 +109,7 @@ void register_sweep(CLI::App& app, Action& action) {
         if (!knob.skipped.empty()) continue;
         std::string name = "sweep_";
         name.append(knob.knob->name).append(".png");
-        dir.write_png(name, sweep_plot(result, knob));
+        write_sweep_plot(dir.file(name), result, knob);
         ++plots;
       }
       dir.write_text("report.json", sweep_json(result).dump(2) + "\n");

@@ -2,8 +2,8 @@
 
 #include "trm/encoder_json.hpp"
 #include "trm/metrics.hpp"
+#include "trm/plot.hpp"
 
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -90,164 +90,15 @@ std::string header_line(const SweepResult& r) {
 
 // ---- plots ----
 
-struct Axis {
-  double lo = 0, hi = 1;
-  bool log = false;
-  std::string label;
-};
-
-double nice_step(double raw) {
-  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * magnitude >= raw) return m * magnitude;
-  }
-  return 10.0 * magnitude;
-}
-
-// An axis over the values; logarithmic when allowed, all positive and spanning at least a factor of 8.
-Axis make_axis(const std::vector<double>& values, bool allow_log, std::string label) {
-  Axis a;
+// A knob's values, memory or times as an axis: logarithmic when all positive and spanning a factor of 8 or more.
+plot::Axis spread_axis(const std::vector<double>& values, std::string label) {
+  plot::Axis a;
   a.label = std::move(label);
-  double lo = *std::min_element(values.begin(), values.end());
-  double hi = *std::max_element(values.begin(), values.end());
-  if (allow_log && lo > 0 && hi / lo >= 8.0) {
-    a.log = true;
-    a.lo = std::pow(10.0, std::floor(std::log10(lo)));
-    a.hi = std::pow(10.0, std::ceil(std::log10(hi)));
-    if (a.hi <= a.lo) a.hi = a.lo * 10.0;
-    return a;
-  }
-  if (hi - lo <= std::abs(hi) * 1e-9) {
-    const double pad = std::max(std::abs(lo) * 0.1, 1e-9);
-    lo -= pad;
-    hi += pad;
-  }
-  const double step = nice_step((hi - lo) / 5.0);
-  a.lo = std::floor(lo / step) * step;
-  a.hi = std::ceil(hi / step) * step;
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  if (*lo > 0 && *hi / *lo >= 8.0) a.scale = plot::Scale::Log;
   return a;
 }
 
-// Error axis (log): decades around the positive values; zeros are drawn on the bottom edge.
-Axis error_axis(const std::vector<std::vector<double>>& series) {
-  double lo = 0, hi = 0;
-  for (const auto& s : series) {
-    for (double v : s) {
-      if (v <= 0) continue;
-      lo = lo == 0 ? v : std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-  }
-  Axis a;
-  a.log = true;
-  a.label = "error vs reference (output LSB), log; 0 on the bottom edge";
-  if (hi == 0) {
-    a.lo = 1e-4;
-    a.hi = 1.0;
-    return a;
-  }
-  a.lo = std::pow(10.0, std::floor(std::log10(lo)) - (lo == hi ? 1 : 0));
-  a.hi = std::pow(10.0, std::ceil(std::log10(hi * 2.0)));  // headroom for the value labels above the markers
-  return a;
-}
-
-double unit(const Axis& a, double v) {
-  if (a.log) {
-    if (v <= 0) return 0.0;
-    return (std::log10(v) - std::log10(a.lo)) / (std::log10(a.hi) - std::log10(a.lo));
-  }
-  return (v - a.lo) / (a.hi - a.lo);
-}
-
-std::vector<double> ticks(const Axis& a) {
-  std::vector<double> t;
-  if (a.log) {
-    const int decades = static_cast<int>(std::lround(std::log10(a.hi / a.lo)));
-    for (double d = a.lo; d <= a.hi * 1.0001; d *= 10.0) {
-      for (double m : decades <= 2 ? std::vector<double>{1, 2, 5} : std::vector<double>{1}) {
-        if (m * d <= a.hi * 1.0001) t.push_back(m * d);
-      }
-    }
-    return t;
-  }
-  const double step = nice_step((a.hi - a.lo) / 5.0);
-  for (double v = a.lo; v <= a.hi + step * 1e-6; v += step) t.push_back(std::abs(v) < step * 1e-9 ? 0.0 : v);
-  return t;
-}
-
-std::string tick_text(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%g", v);
-  return buffer;
-}
-
-const int kFont = cv::FONT_HERSHEY_SIMPLEX;
-
-void text(cv::Mat& canvas, const std::string& s, cv::Point at, double scale = 0.42,
-          cv::Scalar colour = cv::Scalar(0, 0, 0)) {
-  cv::putText(canvas, s, at, kFont, scale, colour, 1, cv::LINE_AA);
-}
-
-int text_width(const std::string& s, double scale = 0.42) {
-  int baseline = 0;
-  return cv::getTextSize(s, kFont, scale, 1, &baseline).width;
-}
-
-struct Series {
-  std::string label;
-  cv::Scalar colour;  // RGB
-  std::vector<double> y;
-};
-
-// One panel: error series against x, points in value order joined by lines when `join`; the base point ringed;
-// `labels` written beside the first series' markers.
-void draw_panel(cv::Mat& canvas, cv::Rect area, const std::string& title, const Axis& xa, const std::vector<double>& x,
-                const Axis& ya, const std::vector<Series>& series, int base_index, bool join,
-                const std::vector<std::string>& labels) {
-  const cv::Rect plot(area.x + 62, area.y + 44, area.width - 80, area.height - 100);
-  const cv::Scalar grid(225, 225, 225), black(0, 0, 0);
-  text(canvas, title, cv::Point(area.x + 10, area.y + 18), 0.5);
-  text(canvas, ya.label, cv::Point(area.x + 10, area.y + 36), 0.38, cv::Scalar(90, 90, 90));
-  const auto px = [&](double v) { return plot.x + static_cast<int>(std::lround(unit(xa, v) * plot.width)); };
-  const auto py = [&](double v) {
-    return plot.y + plot.height - static_cast<int>(std::lround(std::clamp(unit(ya, v), 0.0, 1.0) * plot.height));
-  };
-  for (double t : ticks(xa)) {
-    const int X = px(t);
-    cv::line(canvas, {X, plot.y}, {X, plot.y + plot.height}, grid, 1);
-    const std::string s = tick_text(t);
-    text(canvas, s, cv::Point(X - text_width(s, 0.38) / 2, plot.y + plot.height + 16), 0.38);
-  }
-  for (double t : ticks(ya)) {
-    const int Y = py(t);
-    cv::line(canvas, {plot.x, Y}, {plot.x + plot.width, Y}, grid, 1);
-    const std::string s = tick_text(t);
-    text(canvas, s, cv::Point(plot.x - 6 - text_width(s, 0.38), Y + 4), 0.38);
-  }
-  cv::rectangle(canvas, plot, black, 1);
-  const std::string xlabel = xa.label + (xa.log ? " (log)" : "");
-  text(canvas, xlabel, cv::Point(plot.x + (plot.width - text_width(xlabel)) / 2, plot.y + plot.height + 38));
-
-  for (const Series& s : series) {
-    cv::Point previous(-1, -1);
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      const cv::Point p(px(x[i]), py(s.y[i]));
-      if (join && previous.x >= 0) cv::line(canvas, previous, p, s.colour, 1, cv::LINE_AA);
-      previous = p;
-      if (s.y[i] > 0) {
-        cv::circle(canvas, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
-      } else {
-        cv::circle(canvas, p, 3, s.colour, 1, cv::LINE_AA);  // zero: hollow, on the bottom edge
-      }
-      if (static_cast<int>(i) == base_index) cv::circle(canvas, p, 7, black, 1, cv::LINE_AA);
-    }
-  }
-  if (!labels.empty() && !series.empty()) {
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      text(canvas, labels[i], cv::Point(px(x[i]) + 5, py(series.front().y[i]) - 6), 0.34, cv::Scalar(60, 60, 60));
-    }
-  }
-}
 
 }  // namespace
 
@@ -437,78 +288,82 @@ Json sweep_json(const SweepResult& r) {
   return j;
 }
 
-cv::Mat sweep_plot(const SweepResult& r, const SweepKnobResult& k) {
-  const int panel_w = 540, panel_h = 440, top = 56;
-  cv::Mat canvas(top + panel_h, 3 * panel_w, CV_8UC3, cv::Scalar(255, 255, 255));
+void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, const SweepKnobResult& k) {
   std::vector<const SweepPoint*> points;
   for (const auto& p : k.points) {
     if (p.ok()) points.push_back(&p);
   }
-  std::string title = k.knob->name;
-  title.append(": ").append(k.knob->description);
-  text(canvas, title, cv::Point(10, 20), 0.5);
-  std::string subtitle = header_line(r);
-  subtitle.append("; memory at ").append(std::to_string(r.options.hw_size.width)).append("x").append(
+  plot::Figure figure;
+  figure.width = 1620;
+  figure.height = 500;
+  figure.title = k.knob->name;
+  figure.title.append(": ").append(k.knob->description);
+  figure.subtitle = header_line(r);
+  figure.subtitle.append("; memory at ").append(std::to_string(r.options.hw_size.width)).append("x").append(
       std::to_string(r.options.hw_size.height));
   const int rejected = static_cast<int>(k.points.size() - points.size());
-  if (rejected > 0) subtitle.append("; ").append(std::to_string(rejected)).append(" value(s) rejected, not drawn");
-  text(canvas, subtitle, cv::Point(10, 38), 0.4, cv::Scalar(70, 70, 70));
-  // Legend.
-  const std::vector<std::pair<std::string, cv::Scalar>> legend = {
-      {"max |d|", cv::Scalar(200, 30, 30)},
-      {"RMS |d|", cv::Scalar(30, 140, 40)},
-      {"mean |d|", cv::Scalar(30, 70, 200)}};
-  int lx = 3 * panel_w - 420;
-  for (const auto& [label, colour] : legend) {
-    cv::circle(canvas, cv::Point(lx, 50), 4, colour, cv::FILLED, cv::LINE_AA);
-    text(canvas, label, cv::Point(lx + 8, 54), 0.4);
-    lx += 90;
+  if (rejected > 0) {
+    figure.subtitle.append("; ").append(std::to_string(rejected)).append(" value(s) rejected, not drawn");
   }
-  cv::circle(canvas, cv::Point(lx, 50), 7, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  text(canvas, "base value", cv::Point(lx + 10, 54), 0.4);
   if (points.empty()) {
-    text(canvas, "no value of this knob was accepted", cv::Point(20, top + 60), 0.6);
-    return canvas;
+    plot::Chart chart;
+    chart.note = "no value of this knob was accepted";
+    figure.charts = {chart};
+    plot::write_png(path, figure);
+    return;
   }
 
-  std::vector<double> x_value, x_memory, x_time;
-  std::vector<Series> series = {{"max", cv::Scalar(200, 30, 30), {}},
-                                {"rms", cv::Scalar(30, 140, 40), {}},
-                                {"mean", cv::Scalar(30, 70, 200), {}}};
-  std::vector<std::string> labels;
-  int base_index = -1;
   bool on_varies = false, off_varies = false;
   for (const SweepPoint* p : points) {
     on_varies = on_varies || p->on_chip_bits != points.front()->on_chip_bits;
     off_varies = off_varies || p->off_chip_bits != points.front()->off_chip_bits;
   }
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const SweepPoint& p = *points[i];
-    if (p.is_default) base_index = static_cast<int>(i);
-    x_value.push_back(p.value);
-    const std::int64_t bits = off_varies && on_varies ? p.on_chip_bits + p.off_chip_bits
-                              : off_varies            ? p.off_chip_bits
-                                                      : p.on_chip_bits;
+  std::vector<double> x_value, x_memory, x_time, max_lsb, rms_lsb, mean_lsb;
+  std::vector<std::string> labels;
+  const SweepPoint* base = nullptr;
+  for (const SweepPoint* p : points) {
+    if (p->is_default) base = p;
+    x_value.push_back(p->value);
+    const std::int64_t bits = off_varies && on_varies ? p->on_chip_bits + p->off_chip_bits
+                              : off_varies            ? p->off_chip_bits
+                                                      : p->on_chip_bits;
     x_memory.push_back(static_cast<double>(bits) / 8.0 / 1024.0);
-    x_time.push_back(p.min_seconds_per_frame * 1e3);
-    series[0].y.push_back(p.max_lsb);
-    series[1].y.push_back(p.rms_lsb);
-    series[2].y.push_back(p.mean_lsb);
-    labels.push_back(std::to_string(p.value));
+    x_time.push_back(p->min_seconds_per_frame * 1e3);
+    max_lsb.push_back(p->max_lsb);
+    rms_lsb.push_back(p->rms_lsb);
+    mean_lsb.push_back(p->mean_lsb);
+    labels.push_back(std::to_string(p->value));
   }
-  const Axis ya = error_axis({series[0].y, series[1].y, series[2].y});
   const std::string memory_label = on_varies && off_varies ? "on + off chip memory (KiB)"
                                    : off_varies            ? "off-chip memory (KiB)"
                                                            : "on-chip memory (KiB)";
-  draw_panel(canvas, cv::Rect(0, top, panel_w, panel_h), "error vs knob value",
-             make_axis(x_value, true, k.knob->name), x_value, ya, series, base_index, true, {});
-  draw_panel(canvas, cv::Rect(panel_w, top, panel_w, panel_h),
-             on_varies || off_varies ? "error vs memory" : "error vs memory (unchanged by this knob)",
-             make_axis(x_memory, true, memory_label), x_memory, ya, series, base_index, true, labels);
-  draw_panel(canvas, cv::Rect(2 * panel_w, top, panel_w, panel_h), "error vs decode time",
-             make_axis(x_time, true, "decode time per view, ms (fastest of the repeats)"), x_time, ya, series,
-             base_index, false, labels);
-  return canvas;
+  // The three errors against one x; zeros (exact agreement) sit hollow on the lower edge of the log error axis.
+  const auto chart = [&](std::string title, const std::vector<double>& x, plot::Axis x_axis, plot::Style style,
+                         bool value_labels) {
+    plot::Chart c;
+    c.title = std::move(title);
+    c.x = std::move(x_axis);
+    c.y.label = "error vs reference (output LSB), 0 on the lower edge";
+    c.y.scale = plot::Scale::Log;
+    c.y.nonpositive_on_edge = true;
+    c.series = {{.label = "max |d|", .x = x, .y = max_lsb, .style = style, .colour = 3},
+                {.label = "RMS |d|", .x = x, .y = rms_lsb, .style = style, .colour = 2},
+                {.label = "mean |d|", .x = x, .y = mean_lsb, .style = style, .colour = 0}};
+    if (value_labels) c.series.front().point_labels = labels;
+    if (base) {
+      const auto i = static_cast<std::size_t>(std::find(points.begin(), points.end(), base) - points.begin());
+      for (const std::vector<double>* y : {&max_lsb, &rms_lsb, &mean_lsb}) c.rings.push_back({x[i], (*y)[i]});
+      c.rings_label = "base value";
+    }
+    return c;
+  };
+  figure.charts = {
+      chart("error vs knob value", x_value, spread_axis(x_value, k.knob->name), plot::Style::LineAndPoints, false),
+      chart(on_varies || off_varies ? "error vs memory" : "error vs memory (unchanged by this knob)", x_memory,
+            spread_axis(x_memory, memory_label), plot::Style::LineAndPoints, true),
+      chart("error vs decode time", x_time, spread_axis(x_time, "decode time per view, ms (fastest of the repeats)"),
+            plot::Style::Points, true)};
+  plot::write_png(path, figure);
 }
 
 std::string sweep_summary(const SweepResult& r) {

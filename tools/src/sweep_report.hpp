@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include <filesystem>
 #include <string>
 
 namespace trm::cli {
@@ -17,8 +18,8 @@ std::string sweep_csv(const SweepResult& result);
 std::string sweep_markdown(const SweepResult& result);
 // report.json: parameters, base configuration and every point.
 Json sweep_json(const SweepResult& result);
-// sweep_<knob>.png: error against knob value, against memory and against decode time (RGB).
-cv::Mat sweep_plot(const SweepResult& result, const SweepKnobResult& knob);
+// sweep_<knob>.png: error against knob value, against memory and against decode time.
+void write_sweep_plot(const std::filesystem::path& path, const SweepResult& result, const SweepKnobResult& knob);
 // The short table printed to stdout: per knob, the base point and the cheapest point meeting the criterion.
 std::string sweep_summary(const SweepResult& result);
 

@@ -71,6 +71,9 @@ class AtomicFile {
   void write(std::string_view text);
   void commit();
   const std::filesystem::path& target() const { return target_; }
+  // Where the bytes are until commit(), for a library that writes only to a file name: it must have written and
+  // closed the file before commit().
+  const std::filesystem::path& staging_path() const { return staging_.path(); }
 
  private:
   void flush();

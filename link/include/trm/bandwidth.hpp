@@ -107,12 +107,7 @@ class FramesCsvWriter {
 void write_frames_csv(const std::filesystem::path& path, std::span<const LinkFrameUsage> frames, double refresh_hz,
                       const std::string& method);
 
-struct PlotSeries {
-  std::string label;
-  std::vector<double> bits_per_frame;  // one value per link frame
-};
-
-// A plotted series of any length in bounded memory: consecutive values are folded into at most max_buckets
+// A series of bits per link frame of any length in bounded memory, for plotting: consecutive values are folded into at most max_buckets
 // buckets of a power-of-two width. Up to max_buckets values each bucket holds one value and the plot is
 // exactly that of the whole series; beyond, a bucket is well under a pixel column wide and its min..max span
 // draws what the whole series would.
@@ -136,13 +131,5 @@ class PlotTrace {
   std::int64_t count_ = 0, width_ = 1;
   std::vector<Bucket> buckets_;
 };
-
-// Line plot of bits per link frame over link frame index, one coloured line per series, with a legend
-// and, when capacity_bits > 0, a dashed horizontal line for the link's capacity per frame. PNG, written
-// to a temporary name and renamed. Throws std::runtime_error on an encode or I/O failure.
-void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotTrace> series, double capacity_bits,
-                         const std::string& title);
-void plot_bits_per_frame(const std::filesystem::path& path, std::span<const PlotSeries> series, double capacity_bits,
-                         const std::string& title);
 
 }  // namespace trm::link
