@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -71,11 +72,24 @@ void add_shifted(const double* src, Line line, double shift, double weight, doub
   shift = std::clamp(shift, -static_cast<double>(line.n + 1), static_cast<double>(line.n + 1));
   const double shift_floor = std::floor(shift);
   const double fraction = shift - shift_floor;
-  for (int j = 0; j < line.n; ++j) {
+  const int offset = static_cast<int>(shift_floor);
+  // Pixels whose sample falls between two pixel centres, j + offset in [0, n − 2], run as one flat loop over
+  // channels (the same arithmetic as sample(), so the edges and the interior agree bit for bit).
+  const int interior_begin = std::clamp(-offset, 0, line.n);
+  const int interior_end = std::clamp(line.n - 1 - offset, interior_begin, line.n);
+  const auto edge = [&](int j) {
     for (int ch = 0; ch < line.c; ++ch) {
       dst[static_cast<std::size_t>(j) * line.c + ch] += weight * sample(src, line, j, ch, shift_floor, fraction);
     }
-  }
+  };
+  for (int j = 0; j < interior_begin; ++j) edge(j);
+  const std::ptrdiff_t stride = line.c;
+  const double* a = src + static_cast<std::ptrdiff_t>(interior_begin + offset) * stride;
+  const double* b = a + stride;
+  double* out = dst + static_cast<std::ptrdiff_t>(interior_begin) * stride;
+  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(interior_end - interior_begin) * stride;
+  for (std::ptrdiff_t q = 0; q < count; ++q) out[q] += weight * (a[q] + (b[q] - a[q]) * fraction);
+  for (int j = interior_end; j < line.n; ++j) edge(j);
 }
 
 // ∫_{p0}^{p1} of the line's interpolant (channel ch), p0 <= p1, each cell's part in closed form.
@@ -227,6 +241,21 @@ Gaze Gaze::pursuit(double target_velocity_deg_s) {
 Gaze Gaze::perfect_pursuit(double target_velocity_deg_s) {
   require_finite("Gaze::perfect_pursuit", "target_velocity_deg_s", target_velocity_deg_s);
   return {target_velocity_deg_s, target_velocity_deg_s};
+}
+
+int substeps_for_error(const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s, double max_error) {
+  constexpr const char* kWhere = "substeps_for_error";
+  require_positive(kWhere, "viewer.pixels_per_degree", viewer.pixels_per_degree);
+  require_finite(kWhere, "eye_velocity_deg_s", eye_velocity_deg_s);
+  if (!(max_error > 0.0 && max_error < 1.0)) {
+    reject(kWhere, "max_error", "must be in (0, 1), got " + number_text(max_error));
+  }
+  const double sweep = std::abs(eye_velocity_deg_s) * viewer.pixels_per_degree *
+                       (light.window_end_s() - light.window_begin_s());
+  // Above a few million steps per frame the caller wants a closed form, not this integrator.
+  constexpr double kMostSubsteps = 1 << 22;
+  const double steps = std::max({1.0, std::ceil(sweep), std::ceil(std::sqrt(sweep / (16.0 * max_error)))});
+  return static_cast<int>(std::min(steps, kMostSubsteps));
 }
 
 cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s,

@@ -3,6 +3,7 @@
 // integral is its closed form, and the sub-stepped integral converges at the order its error analysis predicts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -374,6 +375,42 @@ TEST(RetinalIntegration, ErrorFallsSecondOrderOnceStepsAreBelowAPixel) {
   EXPECT_NEAR(order, 2.0, 0.3);
 }
 
+TEST(RetinalIntegration, StepRuleMeetsItsErrorBound) {
+  struct Case {
+    PanelLight light;
+    Viewer viewer;
+    double speed;
+  };
+  const Case cases[] = {{hold_light(90.0), viewer_preset("vive"), 80.0},
+                        {oled_light(90.0, 0.2), viewer_preset("vive"), 30.0},
+                        {hold_light(100.0), viewer_preset("monitor"), 30.0},
+                        {oled_light(90.0, 0.2), viewer_preset("rift"), 5.0}};
+  for (const Case& c : cases) {
+    const double max_error = 1e-3;
+    RetinaOptions options;
+    options.substeps = substeps_for_error(c.light, c.viewer, c.speed, max_error);
+    const double px_per_frame = c.speed * c.viewer.pixels_per_degree * c.light.frame_period_s();
+    const cv::Mat frames = moving_edge(4, 256 + static_cast<int>(4 * px_per_frame), 60.0, px_per_frame);
+    double worst = 0.0;
+    for (int phase = 0; phase < 8; ++phase) {
+      // The eye starts phase / 8 px behind, so pixel kinks fall at every offset within a step.
+      options.origin_s = phase / (8.0 * c.speed * c.viewer.pixels_per_degree);
+      const double period = c.light.frame_period_s();
+      cv::Mat exact = cv::Mat::zeros(1, frames.cols, CV_64FC1);
+      for (int n = 0; n < frames.rows; ++n) {
+        const double t0 = n * period + c.light.window_begin_s(), t1 = n * period + c.light.window_end_s();
+        exact += ideal_retinal_row(frames.row(n), c.viewer, Gaze{0.0, c.speed}, t0, t1, options.origin_s) * (t1 - t0);
+      }
+      exact /= frames.rows * period * c.light.config().duty;
+      worst = std::max(worst, max_abs_difference(retinal_row(frames, c.light, c.viewer, c.speed, options), exact));
+    }
+    EXPECT_LE(worst, max_error) << c.viewer.name << " " << c.speed << " S = " << options.substeps;
+    EXPECT_GT(worst, max_error / 20.0) << "the rule should not be far too cautious";
+  }
+  EXPECT_EQ(substeps_for_error(hold_light(90.0), viewer_preset("vive"), 80.0, 1e-3), 26);
+  EXPECT_EQ(substeps_for_error(hold_light(90.0), viewer_preset("vive"), 0.0, 1e-3), 1);
+}
+
 // ---- Presets and bad input ----
 
 TEST(Viewer, PresetsCarryTheirPublishedFigures) {
@@ -442,6 +479,8 @@ TEST(BadInput, ThrowsNamingTheArgument) {
                  "target_velocity_deg_s");
   expect_invalid([&] { ideal_retinal_row(frames.row(0), viewer, Gaze{}, 1.0, 1.0); }, "t_end_s");
   expect_invalid([&] { edge_width_px(frames.row(0)); }, "row");
+  expect_invalid([&] { substeps_for_error(light, viewer, kNaN, 1e-3); }, "eye_velocity_deg_s");
+  expect_invalid([&] { substeps_for_error(light, viewer, 1.0, 0.0); }, "max_error");
 }
 
 }  // namespace
