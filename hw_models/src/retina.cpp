@@ -254,7 +254,7 @@ int substeps_for_error(const PanelLight& light, const Viewer& viewer, double eye
                        (light.window_end_s() - light.window_begin_s());
   // Above a few million steps per frame the caller wants a closed form, not this integrator.
   constexpr double kMostSubsteps = 1 << 22;
-  const double steps = std::max({1.0, std::ceil(sweep), std::ceil(std::sqrt(sweep / (16.0 * max_error)))});
+  const double steps = std::max({1.0, std::ceil(sweep), std::ceil(std::sqrt(sweep / (10.0 * max_error)))});
   return static_cast<int>(std::min(steps, kMostSubsteps));
 }
 

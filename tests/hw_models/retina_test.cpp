@@ -407,7 +407,7 @@ TEST(RetinalIntegration, StepRuleMeetsItsErrorBound) {
     EXPECT_LE(worst, max_error) << c.viewer.name << " " << c.speed << " S = " << options.substeps;
     EXPECT_GT(worst, max_error / 20.0) << "the rule should not be far too cautious";
   }
-  EXPECT_EQ(substeps_for_error(hold_light(90.0), viewer_preset("vive"), 80.0, 1e-3), 26);
+  EXPECT_EQ(substeps_for_error(hold_light(90.0), viewer_preset("vive"), 80.0, 1e-3), 32);
   EXPECT_EQ(substeps_for_error(hold_light(90.0), viewer_preset("vive"), 0.0, 1e-3), 1);
 }
 

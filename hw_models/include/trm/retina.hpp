@@ -68,12 +68,13 @@ struct Gaze {
 // Sub-steps per frame, chosen in docs/eye_model.md.
 inline constexpr int kDefaultRetinaSubsteps = 16;
 
-// The sub-steps that keep the retinal error of a pursued unit-contrast edge at or below `max_error`, from the
-// measured rule of docs/eye_model.md: with the eye's travel over a frame's lit part `sweep` pixels
-// (|v_eye| · ppd · lit time), max error ≈ sweep / (16 S²) once steps are under a pixel (S >= sweep). Returns
-// max(1, ⌈sweep⌉, ⌈√(sweep / (16 max_error))⌉). Content with sharper kinks than an interpolated edge (a one-pixel
-// line has twice its slope change) needs √2 more. Throws std::invalid_argument naming the argument (max_error not
-// in (0, 1), eye_velocity_deg_s not finite, ppd not finite and > 0).
+// The sub-steps that keep the retinal error of a pursued unit-contrast edge at or below `max_error`, from the bound
+// measured in docs/eye_model.md: with `sweep` the eye's travel in pixels over a frame's lit part
+// (|v_eye| · ppd · lit time), the maximum error is about sweep / (16 S²), and under sweep / (10 S²) in every measured
+// case, once steps are under a pixel (S >= sweep). Returns max(1, ⌈sweep⌉, ⌈√(sweep / (10 max_error))⌉). Content
+// with sharper kinks than an interpolated edge (a one-pixel line has twice its slope change) needs √2 more. Throws
+// std::invalid_argument naming the argument (max_error not in (0, 1), eye_velocity_deg_s not finite, ppd not finite
+// and > 0).
 int substeps_for_error(const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s, double max_error);
 
 struct RetinaOptions {
