@@ -214,6 +214,22 @@ TEST(HoldTypeBlur, LowPersistenceBlursBySpeedTimesTheOnTime) {
   EXPECT_NEAR(pixels_to_arcmin(edge_width_px(retina), edge.viewer), 0.8 * 60.0 * 0.2 / 90.0 * 60.0, 0.01);
 }
 
+TEST(HoldTypeBlur, StrobedBacklightBlursByTheStrobeAndTheCrystalAddsItsResponse) {
+  const EdgeCase edge;
+  RetinaOptions options;
+  options.substeps = 512;
+  PanelLightOptions strobe;
+  strobe.strobe_duty = 0.25;
+  strobe.lc_tau_s = 1e-9;
+  const cv::Mat strobed = retinal_row(edge.frames, panel_light(parse_panel("lcd"), EdgeCase::kRefresh, strobe),
+                                      edge.viewer, edge.speed_deg_s, options);
+  EXPECT_NEAR(edge_width_px(strobed), 0.8 * 0.25 * 40.0, 0.01);
+  // A slower crystal spreads each frame's edge over its response as well: wider than the instant hold.
+  const double instant = edge_width_px(retinal_row(edge.frames, hold_light(90.0), edge.viewer, edge.speed_deg_s));
+  const double slow = edge_width_px(retinal_row(edge.frames, hold_light(90.0, 0.004), edge.viewer, edge.speed_deg_s));
+  EXPECT_GT(slow, instant + 1.0);
+}
+
 TEST(HoldTypeBlur, ContinuousMotionUnderPerfectPursuitStaysSharp) {
   const EdgeCase edge;
   const cv::Mat ideal = ideal_retinal_row(edge.frames.row(0), edge.viewer, Gaze::perfect_pursuit(edge.speed_deg_s),
@@ -237,6 +253,20 @@ TEST(RetinalIntegration, BlackFrameInsertionHalvesTheMeanLight) {
     const cv::Mat black = retinal_row(bfi, light, custom_viewer(30.0), 10.0);
     EXPECT_NEAR(cv::mean(black)[0] / cv::mean(shown)[0], 0.5, 1e-15);
   }
+}
+
+TEST(RetinalIntegration, InterlacedBlackRowsHalveTheMeanLight) {
+  std::vector<cv::Mat> full(4, cv::Mat(6, 16, CV_64FC3, cv::Scalar(0.3, 0.6, 0.9)));
+  std::vector<cv::Mat> interlaced;
+  for (int n = 0; n < 4; ++n) {
+    cv::Mat frame = full[n].clone();
+    for (int y = n % 2; y < frame.rows; y += 2) frame.row(y).setTo(cv::Scalar::all(0.0));
+    interlaced.push_back(frame);
+  }
+  const PanelLight light = oled_light(90.0, 0.2, ScanOut::Rolling);
+  const cv::Scalar shown = cv::mean(retinal_image(full, light, viewer_preset("vive"), 20.0));
+  const cv::Scalar halved = cv::mean(retinal_image(interlaced, light, viewer_preset("vive"), 20.0));
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(halved[ch] / shown[ch], 0.5, 1e-15) << ch;
 }
 
 TEST(RetinalIntegration, StillEyeSeesTheTimeAverage) {
