@@ -65,7 +65,9 @@ struct Gaze {
 };
 // Each Gaze factory throws std::invalid_argument naming `target_velocity_deg_s` when it is not finite.
 
-// Sub-steps per frame, chosen in docs/eye_model.md.
+// Sub-steps per frame: at the Vive's ppd and 90 Hz every step stays under a pixel of eye travel up to the fastest
+// pursuit (80 deg/s) and a pursued edge within one 8-bit code of the exact image, on the OLED, a held and an LC panel
+// (docs/eye_model.md). Take substeps_for_error for higher ppd or slower refresh.
 inline constexpr int kDefaultRetinaSubsteps = 16;
 
 // The sub-steps that keep the retinal error of a pursued unit-contrast edge at or below `max_error`, from the bound
@@ -79,7 +81,7 @@ int substeps_for_error(const PanelLight& light, const Viewer& viewer, double eye
 
 struct RetinaOptions {
   int substeps = kDefaultRetinaSubsteps;  // S >= 1
-  double origin_s = 0.0;                  // t_origin: when the eye (and the ideal target) is at screen x = 0 offset
+  double origin_s = 0.0;                  // t_origin: when x_eye = 0 (the retinal grid lies on the screen's)
   // For a scan line: which row it is of how many (rolling scan-out delays row y by y / rows · T).
   int row = 0;
   int rows = 1;
