@@ -190,15 +190,13 @@ cv::Mat scan_line_pass(const char* where, const cv::Mat& frames, const PanelLigh
                        double velocity_deg_s, const char* velocity_name, const RetinaOptions& options,
                        const cv::Mat& previous, Steps steps) {
   const Line line = check_scan_line(where, frames, viewer, velocity_deg_s, velocity_name, options, previous);
-  const cv::Mat source = frames.isContinuous() ? frames : frames.clone();
   std::vector<const double*> rows;
-  for (int f = 0; f < source.rows; ++f) rows.push_back(source.ptr<double>(f));
-  const int out_rows = steps == Steps::Lit ? 1 : source.rows * options.substeps;
-  cv::Mat out = cv::Mat::zeros(out_rows, source.cols, source.type());
+  for (int f = 0; f < frames.rows; ++f) rows.push_back(frames.ptr<double>(f));
+  const int out_rows = steps == Steps::Lit ? 1 : frames.rows * options.substeps;
+  cv::Mat out = cv::Mat::zeros(out_rows, frames.cols, frames.type());
   std::vector<double*> out_ptrs;
   for (int m = 0; m < out_rows; ++m) out_ptrs.push_back(out.ptr<double>(m));
-  const cv::Mat before = previous.empty() ? cv::Mat() : previous.clone();
-  line_pass(rows, line, before.empty() ? nullptr : before.ptr<double>(0), light,
+  line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(0), light,
             velocity_deg_s * viewer.pixels_per_degree, light.row_delay_s(options.row, options.rows), options.origin_s,
             options.substeps, steps, out_ptrs);
   return out;
