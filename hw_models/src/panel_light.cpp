@@ -1,0 +1,122 @@
+// Panel light over a frame: emission window times the first-order liquid-crystal state, in closed form.
+#include "trm/panel_light.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "perception_checks.hpp"
+
+namespace trm {
+
+namespace {
+
+using perception_detail::number_text;
+using perception_detail::reject;
+
+// A window that ends within this fraction of the frame end still fits (0.8 + 0.2 is not exactly 1 in binary).
+constexpr double kWindowTolerance = 1e-12;
+
+// Below this x the series of x − 1 + e^{−x} is used: x + expm1(−x) loses log2(x / φ(x)) bits, about 2 at x = 0.5.
+constexpr double kSeriesLimit = 0.5;
+
+// φ(x) = x − 1 + e^{−x} = ∫_0^x (1 − e^{−u}) du, the part of a unit step the LC has not yet delivered, >= 0.
+double unreached(double x) {
+  if (x >= kSeriesLimit) return x + std::expm1(-x);
+  // Σ_{k>=2} (−x)^k / k!; at x = 0.5 the terms after k = 18 are below 1e-22 of the sum.
+  double term = x * x / 2.0;
+  double sum = term;
+  for (int k = 3; k <= 18; ++k) {
+    term *= -x / k;
+    sum += term;
+  }
+  return sum;
+}
+
+}  // namespace
+
+PanelLight::PanelLight(const PanelLightConfig& config) : config_(config) {
+  constexpr const char* kWhere = "PanelLight";
+  perception_detail::require_positive(kWhere, "refresh_hz", config.refresh_hz);
+  if (!(config.duty > 0.0 && config.duty <= 1.0)) {
+    reject(kWhere, "duty", "must be in (0, 1], got " + number_text(config.duty));
+  }
+  if (!(config.window_start >= 0.0 && config.window_start + config.duty <= 1.0 + kWindowTolerance)) {
+    reject(kWhere, "window_start", "must be in [0, 1 - duty], got " + number_text(config.window_start));
+  }
+  if (!(std::isfinite(config.lc_tau_s) && config.lc_tau_s >= 0.0)) {
+    reject(kWhere, "lc_tau_s", "must be finite and >= 0, got " + number_text(config.lc_tau_s));
+  }
+  period_ = 1.0 / config.refresh_hz;
+  window_begin_ = config.window_start * period_;
+  window_end_ = std::min(period_, (config.window_start + config.duty) * period_);
+  decay_ = config.lc_tau_s > 0.0 ? std::exp(-period_ / config.lc_tau_s) : 0.0;
+}
+
+double PanelLight::row_delay_s(int y, int rows) const {
+  if (rows < 1) reject("PanelLight::row_delay_s", "rows", "must be >= 1, got " + std::to_string(rows));
+  if (y < 0 || y >= rows) {
+    reject("PanelLight::row_delay_s", "y", "must be in [0, rows), got " + std::to_string(y));
+  }
+  return config_.scan_out == ScanOut::Rolling ? period_ * y / rows : 0.0;
+}
+
+double PanelLight::level_at(double t, double previous_state, double level) const {
+  if (!(t >= window_begin_ && t < window_end_)) return 0.0;
+  const double tau = config_.lc_tau_s;
+  const double state = tau > 0.0 ? level + (previous_state - level) * std::exp(-t / tau) : level;
+  return state / config_.duty;
+}
+
+LightWeights PanelLight::weights(double t0, double t1) const {
+  constexpr const char* kWhere = "PanelLight::weights";
+  if (!(t0 >= 0.0 && t0 <= period_)) reject(kWhere, "t0", "must be in [0, T], got " + number_text(t0));
+  if (!(t1 >= t0 && t1 <= period_)) reject(kWhere, "t1", "must be in [t0, T], got " + number_text(t1));
+  const double u0 = std::max(t0, window_begin_);
+  const double u1 = std::min(t1, window_end_);
+  if (!(u1 > u0)) return {};
+  const double span = u1 - u0;
+  const double tau = config_.lc_tau_s;
+  const double duty = config_.duty;
+  if (tau == 0.0) return {span / duty, 0.0};
+  // ∫ s = L Δ + (s0 − L) τ e^{−u0/τ} (1 − e^{−Δ/τ}); the level part regrouped as
+  // Δ (1 − e^{−u0/τ}) + e^{−u0/τ} τ φ(Δ/τ) so that a slow LC (Δ ≪ τ) does not subtract two near-equal terms.
+  const double at_start = std::exp(-u0 / tau);
+  const double x = span / tau;
+  const double previous = tau * at_start * -std::expm1(-x);
+  const double level = span * -std::expm1(-u0 / tau) + at_start * tau * unreached(x);
+  return {level / duty, previous / duty};
+}
+
+double PanelLight::integral(double t0, double t1, double previous_state, double level) const {
+  const LightWeights w = weights(t0, t1);
+  return w.level * level + w.previous * previous_state;
+}
+
+double PanelLight::end_state(double previous_state, double level) const {
+  return level + (previous_state - level) * decay_;
+}
+
+PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOptions& options) {
+  panel.validate("panel_light: ");
+  PanelLightConfig config;
+  config.refresh_hz = refresh_hz;
+  config.scan_out = options.scan_out;
+  if (panel.kind == PanelKind::Oled) {
+    config.duty = panel.oled.duty;
+    config.window_start = 0.0;
+    config.lc_tau_s = 0.0;
+  } else {
+    config.duty = options.strobe_duty;
+    if (!(options.strobe_duty > 0.0 && options.strobe_duty <= 1.0)) {
+      reject("panel_light", "strobe_duty", "must be in (0, 1], got " + number_text(options.strobe_duty));
+    }
+    config.window_start = options.strobe_start < 0.0 ? 1.0 - options.strobe_duty : options.strobe_start;
+    config.lc_tau_s = options.lc_tau_s;
+  }
+  return PanelLight(config);
+}
+
+double steady_level(const Panel& panel, double v, int channel) { return panel.linear_from_drive(v, channel); }
+
+}  // namespace trm
