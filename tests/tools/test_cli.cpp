@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -434,4 +435,44 @@ TEST(Cli, CaptureOfAHalfRateRunReplaysWithItsUnsentSlots) {
   EXPECT_NE(fixed.exit_code, 0);
   EXPECT_NE(fixed.output.find("half-rate"), std::string::npos) << fixed.output;
   EXPECT_FALSE(fs::exists(tmp.path() / "f"));
+}
+
+// `trm compare`: every method on the same frames; figures with analytic answers checked, the rest present and finite.
+TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
+  TempDir tmp;
+  const Result run = run_trm("compare --scene panorama --size 216x120 --frames 8 --out " + tmp.str("cmp"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  for (const char* name : {"compare.md", "compare.csv", "report.json"}) {
+    EXPECT_TRUE(fs::exists(tmp.path() / "cmp" / name)) << name;
+  }
+  std::ifstream in(tmp.str("cmp/report.json"));
+  const nlohmann::json report = nlohmann::json::parse(in);
+  std::map<std::string, nlohmann::json> by_method;
+  for (const auto& m : report["methods"]) by_method[m["method"].get<std::string>()] = m;
+  ASSERT_EQ(by_method.size(), 6u);
+  // Pixels: exact fractions of full rate (216x120 at r = 1/2 reduces to 108x60).
+  EXPECT_DOUBLE_EQ(by_method["trm"]["pixels_rendered_saved_percent"].get<double>(), 37.5);
+  EXPECT_DOUBLE_EQ(by_method["ncsfi"]["pixels_rendered_saved_percent"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(by_method["ncsfi"]["pixels_sent_saved_percent"].get<double>(), 37.5);
+  for (const char* half : {"half-rate", "interlace", "bfi"}) {
+    EXPECT_DOUBLE_EQ(by_method[half]["pixels_sent_saved_percent"].get<double>(), 50.0) << half;
+  }
+  EXPECT_DOUBLE_EQ(by_method["full"]["pixels_sent_saved_percent"].get<double>(), 0.0);
+  // Light: black frames and black rows halve it; a repeat does not flicker; full rate is its own reference.
+  EXPECT_NEAR(by_method["bfi"]["luminance_percent"].get<double>(), 50.0, 0.5);
+  EXPECT_NEAR(by_method["interlace"]["luminance_percent"].get<double>(), 50.0, 0.5);
+  EXPECT_NEAR(by_method["trm"]["luminance_percent"].get<double>(), 100.0, 1.0);
+  EXPECT_EQ(by_method["half-rate"]["flicker_contrast"].get<double>(), 0.0);
+  EXPECT_NEAR(by_method["bfi"]["flicker_contrast"].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(by_method["full"]["energy_vs_full_rate"].get<double>(), 0.0);
+  EXPECT_GT(by_method["trm"]["energy_vs_full_rate"].get<double>(), 0.0);
+  // Pursuit of the pan: the half-rate hold blurs more than full rate against continuous motion, black frames less.
+  EXPECT_GT(report["eye"]["target_velocity_deg_s"].get<double>() * report["eye"]["target_velocity_deg_s"].get<double>(), 0.0);
+  EXPECT_GT(by_method["half-rate"]["energy_vs_continuous"].get<double>(), by_method["full"]["energy_vs_continuous"].get<double>());
+  EXPECT_LT(by_method["bfi"]["energy_vs_continuous"].get<double>(), by_method["full"]["energy_vs_continuous"].get<double>());
+  // A subset runs only what is asked (full rate still measured as the reference, not listed).
+  const Result two = run_trm("compare --methods trm,bfi --scene panorama --size 64x48 --frames 4 --out " + tmp.str("two"));
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  std::ifstream in_two(tmp.str("two/report.json"));
+  EXPECT_EQ(nlohmann::json::parse(in_two)["methods"].size(), 2u);
 }

@@ -23,6 +23,10 @@ void register_compare(CLI::App& app, Action& action) {
   cmd->remove_option(cmd->get_option("--impl"));
   cmd->add_option("--methods", options->methods, "Methods to compare, comma separated (default: every method)")
       ->delimiter(',');
+  cmd->add_option("--viewer", options->viewer, "Eye's pixels per degree from a headset preset: vive, rift, monitor")
+      ->capture_default_str();
+  cmd->add_option("--ppd", options->ppd, "Pixels per degree (instead of --viewer's)");
+  cmd->add_option("--substeps", options->substeps, "Retinal sub-frame steps S (default 16, docs/eye_model.md)");
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   cmd->callback([options, out, &action] {
     action = [options, out] {

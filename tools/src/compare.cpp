@@ -5,6 +5,10 @@
 #include "trm/encoder_json.hpp"
 #include "trm/metrics.hpp"
 #include "trm/mtcd.hpp"
+#include "trm/panel_light.hpp"
+#include "trm/pursuit.hpp"
+#include "trm/retina.hpp"
+#include "trm/visual_difference.hpp"
 #include "trm/transfer.hpp"
 
 #include <algorithm>
@@ -20,15 +24,19 @@ namespace trm::cli {
 
 namespace {
 
-// Luma alternation over a pair, |Y_a - Y_b| / (Y_a + Y_b) per pixel (0 where both are black), summed.
-double alternation_contrast_sum(const cv::Mat& luma_a, const cv::Mat& luma_b) {
+// Luma alternation over a pair, |Y_a - Y_b| / (Y_a + Y_b), summed over the pixels lit in either frame (counted in
+// `lit`): a pixel black in both neither flickers nor dilutes the figure.
+double alternation_contrast_sum(const cv::Mat& luma_a, const cv::Mat& luma_b, double& lit) {
   double sum = 0.0;
   for (int y = 0; y < luma_a.rows; ++y) {
     const auto* a = luma_a.ptr<double>(y);
     const auto* b = luma_b.ptr<double>(y);
     for (int x = 0; x < luma_a.cols; ++x) {
       const double total = a[x] + b[x];
-      if (total > 0.0) sum += std::abs(a[x] - b[x]) / total;
+      if (total > 0.0) {
+        sum += std::abs(a[x] - b[x]) / total;
+        lit += 1.0;
+      }
     }
   }
   return sum;
@@ -40,7 +48,8 @@ cv::Mat display_values(const cv::Mat& linear) { return to_encoded(linear, Transf
 // The running figures of one method's run, per view in slot order.
 class MethodMeter {
  public:
-  explicit MethodMeter(const Panel& panel, int output_bits) : panel_(panel), output_bits_(output_bits), pairs_(panel) {}
+  MethodMeter(const Panel& panel, int output_bits, int scan_line)
+      : panel_(panel), output_bits_(output_bits), scan_line_(scan_line), pairs_(panel) {}
 
   void add(const DecodedView& view) {
     const DecodedFrame& shown = *view.decoded;
@@ -63,9 +72,8 @@ class MethodMeter {
       reference_mtcd_sum_ += mtcd({eye.reference_display, display_values(reference)});
       ++mtcd_steps_;
       if (slot.index % 2 == 1) {
-        flicker_sum_ += alternation_contrast_sum(eye.luma, luma_emitted);
-        reference_flicker_sum_ += alternation_contrast_sum(eye.reference_luma, luma_reference);
-        flicker_samples_ += static_cast<double>(luma_emitted.total());
+        flicker_sum_ += alternation_contrast_sum(eye.luma, luma_emitted, flicker_lit_);
+        reference_flicker_sum_ += alternation_contrast_sum(eye.reference_luma, luma_reference, reference_flicker_lit_);
       }
     }
     if (const auto pair = pairs_.add(slot.eye, slot.index, shown.emitted_linear, reference)) {
@@ -76,6 +84,10 @@ class MethodMeter {
         ++finite_pairs_;
       }
     }
+    if (slot.eye == 0) {
+      levels_.push_back(steady_luma_row(shown.drive_codes));
+      if (profile_.empty()) profile_ = luma(view.linear_full->row(scan_line_));
+    }
     eye.t = slot.index;
     eye.luma = luma_emitted;
     eye.reference_luma = luma_reference;
@@ -83,13 +95,17 @@ class MethodMeter {
     eye.reference_display = display_values(reference);
   }
 
+  // The scan line's x-t images (rows: frames of eye 0, steady levels the frames drive) and the scene's line at t = 0.
+  cv::Mat levels() const { return stacked(levels_); }
+  const cv::Mat& profile() const { return profile_; }
+
   void finish(MethodMeasure& m) const {
     m.views = views_;
     m.pixels_rendered_saved_percent = full_pixels_ > 0 ? 100.0 * (1.0 - pixels_rendered_ / full_pixels_) : 0.0;
     m.pixels_sent_saved_percent = full_pixels_ > 0 ? 100.0 * (1.0 - pixels_sent_ / full_pixels_) : 0.0;
     m.luminance_percent = reference_luma_sum_ > 0 ? 100.0 * luma_sum_ / reference_luma_sum_ : 0.0;
-    m.flicker_contrast = flicker_samples_ > 0 ? flicker_sum_ / flicker_samples_ : 0.0;
-    m.reference_flicker_contrast = flicker_samples_ > 0 ? reference_flicker_sum_ / flicker_samples_ : 0.0;
+    m.flicker_contrast = flicker_lit_ > 0 ? flicker_sum_ / flicker_lit_ : 0.0;
+    m.reference_flicker_contrast = reference_flicker_lit_ > 0 ? reference_flicker_sum_ / reference_flicker_lit_ : 0.0;
     m.mtcd = mtcd_steps_ > 0 ? mtcd_sum_ / mtcd_steps_ : 0.0;
     m.reference_mtcd = mtcd_steps_ > 0 ? reference_mtcd_sum_ / mtcd_steps_ : 0.0;
     m.pairs = pair_count_;
@@ -103,14 +119,34 @@ class MethodMeter {
     std::int64_t t = -2;
     cv::Mat luma, reference_luma, display, reference_display;
   };
+  // The light the scan line's drive codes hold on the panel (luma): what PanelLight integrates over a frame.
+  cv::Mat steady_luma_row(const cv::Mat& drive_codes) const {
+    const double top = std::ldexp(1.0, output_bits_) - 1.0;
+    cv::Mat rgb(1, drive_codes.cols, CV_64FC3);
+    const auto* code = drive_codes.ptr<cv::Vec3w>(scan_line_);
+    auto* out = rgb.ptr<cv::Vec3d>(0);
+    for (int x = 0; x < drive_codes.cols; ++x) {
+      for (int c = 0; c < 3; ++c) out[x][c] = steady_level(panel_, code[x][c] / top, c);
+    }
+    return luma(rgb);
+  }
+  static cv::Mat stacked(const std::vector<cv::Mat>& rows) {
+    cv::Mat out;
+    if (!rows.empty()) cv::vconcat(rows, out);
+    return out;
+  }
+
   const Panel& panel_;
   int output_bits_;
+  int scan_line_;
   PairTracker pairs_;
+  std::vector<cv::Mat> levels_;
+  cv::Mat profile_;
   std::map<int, Eye> eyes_;
   std::int64_t views_ = 0;
   double full_pixels_ = 0, pixels_rendered_ = 0, pixels_sent_ = 0;
   double luma_sum_ = 0, reference_luma_sum_ = 0;
-  double flicker_sum_ = 0, reference_flicker_sum_ = 0, flicker_samples_ = 0;
+  double flicker_sum_ = 0, reference_flicker_sum_ = 0, flicker_lit_ = 0, reference_flicker_lit_ = 0;
   double mtcd_sum_ = 0, reference_mtcd_sum_ = 0;
   std::int64_t mtcd_steps_ = 0;
   double psnr_sum_ = 0;
@@ -142,6 +178,8 @@ const std::vector<Column>& columns() {
       {"MTCD", [](const MethodMeasure& m) { return number(m.mtcd, 3); }},
       {"MTCD (full rate)", [](const MethodMeasure& m) { return number(m.reference_mtcd, 3); }},
       {"pair PSNR dB", [](const MethodMeasure& m) { return number(m.mean_pair_psnr_db, 2); }},
+      {"energy vs full rate", [](const MethodMeasure& m) { return number(m.energy_vs_full_rate, 2); }},
+      {"energy vs continuous", [](const MethodMeasure& m) { return number(m.energy_vs_continuous, 2); }},
   };
   return all;
 }
@@ -157,6 +195,15 @@ std::vector<std::string> CompareOptions::chosen_methods() const {
 
 void CompareOptions::validate() const {
   pipeline.validate();
+  if (ppd && !(std::isfinite(*ppd) && *ppd > 0.0)) {
+    throw std::invalid_argument("--ppd must be a finite number of pixels per degree > 0");
+  }
+  if (substeps < 0) throw std::invalid_argument("--substeps must be >= 1 (leave it out for the default)");
+  try {
+    (void)viewer_preset(viewer);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--viewer: ") + e.what());
+  }
   std::set<std::string> seen;
   for (const std::string& spec : chosen_methods()) {
     try {
@@ -175,10 +222,40 @@ CompareResult run_compare(const CompareOptions& options,
   result.options = options;
   const std::vector<std::string> methods = options.chosen_methods();
   const std::int64_t frames = options.pipeline.frames > 0 ? options.pipeline.frames : options.pipeline.default_frames;
-  const std::int64_t total =
-      static_cast<std::int64_t>(methods.size()) * frames * (options.pipeline.encoder.stereo ? 2 : 1);
+  const bool full_listed = std::find(methods.begin(), methods.end(), "full") != methods.end();
+  const std::int64_t total = static_cast<std::int64_t>(methods.size() + (full_listed ? 0 : 1)) * frames *
+                             (options.pipeline.encoder.stereo ? 2 : 1);
   std::int64_t done = 0;
-  for (const std::string& spec : methods) {
+  // The pursued target: the scene's global motion, else its fastest object; the eye follows it along the row
+  // through its centre at t = 0. Inputs without known motion are watched at a fixed gaze.
+  const std::unique_ptr<FrameSource> source = options.pipeline.open_source();
+  const Motion motion = source->motion(0);
+  double target_px_s = motion.global_velocity_px_s[0];
+  result.scan_line = source->height() / 2;
+  if (target_px_s == 0.0) {
+    for (const MotionObject& object : motion.objects) {
+      if (std::abs(object.velocity_px_s[0]) > std::abs(target_px_s)) {
+        target_px_s = object.velocity_px_s[0];
+        const double centre = object.bounds.y + 0.5 * object.bounds.height;
+        result.scan_line = std::clamp(static_cast<int>(centre), 0, source->height() - 1);
+      }
+    }
+  }
+  const Viewer viewer = options.ppd ? custom_viewer(*options.ppd) : viewer_preset(options.viewer);
+  result.pixels_per_degree = viewer.pixels_per_degree;
+  result.target_velocity_deg_s = target_px_s / viewer.pixels_per_degree;
+  result.substeps = options.substeps > 0 ? options.substeps : kDefaultRetinaSubsteps;
+  const PanelLight light = panel_light(options.pipeline.panel, options.pipeline.refresh_hz);
+  const Gaze gaze = Gaze::pursuit(result.target_velocity_deg_s);
+  RetinaOptions retina;
+  retina.substeps = result.substeps;
+  retina.row = result.scan_line;
+  retina.rows = source->height();
+  const double xt_rate = xt_samples_per_second(light, result.substeps);
+  const double lag = retinal_velocity_deg_s(result.target_velocity_deg_s);
+  cv::Mat profile;  // the scan line of the scene at t = 0: what moves continuously in the ideal reference
+  // One method's run: its measures, and its scan line's x-t levels for the pursuit energies.
+  const auto run_method = [&](const std::string& spec, cv::Mat& levels) {
     PipelineOptions run = options.pipeline;
     run.method = spec;
     // Every method is judged in linear light (DESIGN §9): the double-precision headset side for all of them.
@@ -186,7 +263,7 @@ CompareResult run_compare(const CompareOptions& options,
     run.impl_given = false;
     run.compare_reference = false;
     if (run.link_preset.empty()) run.link_preset = "dp1.4";  // bandwidth per link frame for every method
-    MethodMeter meter(run.panel, run.output_bits);
+    MethodMeter meter(run.panel, run.output_bits, result.scan_line);
     MethodMeasure measure;
     measure.method = spec;
     double payload_sum = 0.0;
@@ -205,10 +282,32 @@ CompareResult run_compare(const CompareOptions& options,
         });
     measure.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     meter.finish(measure);
+    levels = meter.levels();
+    profile = meter.profile();
     measure.mean_link_payload_bits = link_frames > 0 ? payload_sum / static_cast<double>(link_frames) : 0.0;
     if (outcome.link) {
       measure.peak_link_wire_bits = outcome.link->summary.peak_wire_bits;
       measure.link_fits = outcome.link->summary.fits;
+    }
+    return measure;
+  };
+  // Full-rate rendering over the same link is the reference of the artefact energy, so that the link's quantisation,
+  // which every method shares, is not counted as an artefact. It runs first, listed or not.
+  cv::Mat full_levels;
+  const MethodMeasure full_rate = run_method("full", full_levels);
+  for (const std::string& spec : methods) {
+    cv::Mat levels;
+    MethodMeasure measure = spec == "full" ? full_rate : run_method(spec, levels);
+    if (spec == "full") levels = full_levels;
+    if (levels.rows >= 2) {
+      const cv::Mat seen = target_frame_xt(levels, light, viewer, gaze, retina);
+      const cv::Mat full_rate_seen = target_frame_xt(full_levels, light, viewer, gaze, retina);
+      const cv::Mat continuous = ideal_xt(profile, viewer, result.target_velocity_deg_s,
+                                          result.target_velocity_deg_s, seen.rows, 1.0 / xt_rate);
+      measure.energy_vs_full_rate =
+          visual_difference_energy(seen, full_rate_seen, viewer.pixels_per_degree, xt_rate, lag);
+      measure.energy_vs_continuous =
+          visual_difference_energy(seen, continuous, viewer.pixels_per_degree, xt_rate, lag);
     }
     result.methods.push_back(std::move(measure));
   }
@@ -243,7 +342,9 @@ std::string compare_markdown(const CompareResult& result) {
       << (p.input.empty() ? p.scene : p.input) << ", " << result.size.width << "x" << result.size.height << ", "
       << p.refresh_hz << " Hz, r = " << p.encoder.reduction << ", panel " << p.panel.name << ", link "
       << (p.link_preset.empty() ? "dp1.4" : p.link_preset) << ". Fractions against full-rate rendering of the same "
-      << "frames; flicker and pair PSNR at a fixed gaze (Talbot-Plateau).\n\n|";
+      << "frames; flicker and pair PSNR at a fixed gaze (Talbot-Plateau); the energies (supplement Eqs. 1-4) for an eye "
+      << "pursuing the target at " << number(result.target_velocity_deg_s, 2) << " deg/s along row " << result.scan_line
+      << " at " << number(result.pixels_per_degree, 2) << " ppd, " << result.substeps << " sub-frame steps.\n\n|";
   for (const Column& c : columns()) out << " " << c.header << " |";
   out << "\n|";
   for (std::size_t i = 0; i < columns().size(); ++i) out << (i == 0 ? "---|" : "---:|");
@@ -260,7 +361,7 @@ std::string compare_csv(const CompareResult& result) {
   std::ostringstream out;
   out << "method,views,pixels_rendered_saved_percent,pixels_sent_saved_percent,mean_link_payload_bits,"
          "peak_link_wire_bits,link_fits,luminance_percent,flicker_contrast,reference_flicker_contrast,mtcd,"
-         "reference_mtcd,pairs,mean_pair_psnr_db,seconds\n";
+         "reference_mtcd,pairs,mean_pair_psnr_db,energy_vs_full_rate,energy_vs_continuous,seconds\n";
   out.precision(10);
   for (const MethodMeasure& m : result.methods) {
     out << m.method << ',' << m.views << ',' << m.pixels_rendered_saved_percent << ',' << m.pixels_sent_saved_percent
@@ -268,7 +369,7 @@ std::string compare_csv(const CompareResult& result) {
         << m.luminance_percent << ',' << m.flicker_contrast << ',' << m.reference_flicker_contrast << ',' << m.mtcd
         << ',' << m.reference_mtcd << ',' << m.pairs << ','
         << (std::isinf(m.mean_pair_psnr_db) ? std::string("inf") : number(m.mean_pair_psnr_db, 6)) << ','
-        << m.seconds << '\n';
+        << m.energy_vs_full_rate << ',' << m.energy_vs_continuous << ',' << m.seconds << '\n';
   }
   return out.str();
 }
@@ -287,6 +388,11 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
                      {"panel", p.panel},
                      {"link", p.link_preset.empty() ? "dp1.4" : p.link_preset},
                      {"seed", p.seed}};
+  j["eye"] = {{"pixels_per_degree", result.pixels_per_degree},
+              {"scan_line", result.scan_line},
+              {"target_velocity_deg_s", result.target_velocity_deg_s},
+              {"eye_velocity_deg_s", eye_velocity_deg_s(result.target_velocity_deg_s)},
+              {"substeps", result.substeps}};
   nlohmann::ordered_json methods = nlohmann::ordered_json::array();
   for (const MethodMeasure& m : result.methods) {
     const auto finite = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
@@ -305,6 +411,8 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
                        {"pairs", m.pairs},
                        {"mean_pair_psnr_db", finite(m.mean_pair_psnr_db)},
                        {"pairs_exact", std::isinf(m.mean_pair_psnr_db)},
+                       {"energy_vs_full_rate", m.energy_vs_full_rate},
+                       {"energy_vs_continuous", m.energy_vs_continuous},
                        {"seconds", m.seconds}});
   }
   j["methods"] = methods;

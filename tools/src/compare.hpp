@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,9 @@ namespace trm::cli {
 struct CompareOptions {
   PipelineOptions pipeline;          // scene, size, frames, encoder, panel, link; --method and --impl do not apply
   std::vector<std::string> methods;  // NAME or NAME:OPTION; empty: every registered method
+  std::string viewer = "vive";       // the eye's pixels per degree (trm/retina.hpp presets: vive, rift, monitor)
+  std::optional<double> ppd;         // pixels per degree instead of the viewer preset's (finite, > 0)
+  int substeps = 0;                  // retinal sub-frame steps S; 0: kDefaultRetinaSubsteps
   // Throws std::invalid_argument with one clear message (an unknown method, one named twice, bad shared options).
   void validate() const;
   // The methods compared, in order: the asked ones, or every registered method.
@@ -31,11 +35,17 @@ struct MethodMeasure {
   std::uint64_t peak_link_wire_bits = 0;
   bool link_fits = true;
   double luminance_percent = 0.0;               // mean emitted luma against the full-rate emission's
-  double flicker_contrast = 0.0;                // mean |Y_2k - Y_2k+1| / (Y_2k + Y_2k+1) over pixels and pairs
+  double flicker_contrast = 0.0;                // mean |Y_2k - Y_2k+1| / (Y_2k + Y_2k+1) over lit pixels and pairs
   double reference_flicker_contrast = 0.0;      // the same of the full-rate emission (motion alone alternates too)
   double mtcd = 0.0;                            // Kim et al. Eq. 6 on the emitted light's 8-bit sRGB encoding
   double reference_mtcd = 0.0;
   double mean_pair_psnr_db = 0.0;               // fixed gaze, against the full-rate reference pair; +inf: exact
+  // The eye pursuing the scene's target along its scan line (supplement Eqs. 1-4 on the x-t image in the target's
+  // frame, the pursuit lag of Eq. 3): the visual difference energy against the `full` method over the same link
+  // (artefacts) and against the target moving continuously (what any frame-based display loses: hold-type blur,
+  // judder).
+  double energy_vs_full_rate = 0.0;
+  double energy_vs_continuous = 0.0;
   std::int64_t pairs = 0;
   double seconds = 0.0;                         // wall time of this method's run
 };
@@ -43,6 +53,10 @@ struct MethodMeasure {
 struct CompareResult {
   CompareOptions options;
   cv::Size size;
+  double pixels_per_degree = 0.0;
+  int scan_line = 0;                  // the row the eye model follows the target along
+  double target_velocity_deg_s = 0.0; // horizontal speed of the pursued target
+  int substeps = 0;
   std::vector<MethodMeasure> methods;
 };
 
