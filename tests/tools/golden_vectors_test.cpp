@@ -73,7 +73,12 @@ TEST(HwReport, WritesJsonWithTotalsAndThePaperComparison) {
   std::ifstream in(dir / "hw.json");
   const auto report = nlohmann::json::parse(in);
   const auto& hw = report["hardware"];
-  EXPECT_EQ(report["parameters"]["residual_format"].get<std::string>().rfind("sQ2.16", 0), 0u);
+  // --residual-bits 18 is sQ2.16, as the one decoder-configuration writer records it.
+  const auto& residual = report["parameters"]["decoder"]["residual"];
+  EXPECT_EQ(residual["int_bits"], 2);
+  EXPECT_EQ(residual["frac_bits"], 16);
+  EXPECT_EQ(residual["signed"], true);
+  EXPECT_EQ(report["parameters"]["decoder"]["decoder"]["panel"]["kind"], "lcd");
   const auto& totals = hw["totals"];
   EXPECT_EQ(totals["on_chip_bits"].get<std::int64_t>(),
             totals["line_buffer_bits"].get<std::int64_t>() + totals["rom_bits"].get<std::int64_t>());

@@ -5,7 +5,7 @@
 #include "output_dir.hpp"
 
 #include "trm/atomic_file.hpp"
-#include "trm/encoder_json.hpp"
+#include "trm/decoder_json.hpp"
 
 #include <iostream>
 #include <memory>
@@ -31,11 +31,7 @@ void register_hw_report(CLI::App& app, Action& action) {
       const FixedStreamingDecoder decoder(config);  // validates the configuration
       Json report;
       report["parameters"] = {{"size", {options->width, options->height}},
-                              {"encoder", encoder_json(options->encoder)},
-                              {"panel", options->panel},
-                              {"output_bits", options->output_bits},
-                              {"residual_format", config.residual.to_string()},
-                              {"linear_frac_bits", config.linear_frac_bits}};
+                              {"decoder", fixed_decoder_json(config)}};
       report["hardware"] = hardware_json(decoder.report(cv::Size(options->width, options->height)));
       const std::string text = report.dump(2) + "\n";
       if (!out->empty()) {

@@ -6,7 +6,7 @@
 #include "vectors.hpp"
 
 #include "trm/atomic_file.hpp"
-#include "trm/encoder_json.hpp"
+#include "trm/decoder_json.hpp"
 
 #include <cstdio>
 #include <iostream>
@@ -45,9 +45,7 @@ void register_vectors(CLI::App& app, Action& action) {
       report["parameters"] = {{"scene", options->scene},
                               {"size", {options->width, options->height}},
                               {"frames", options->frames},
-                              {"encoder", encoder_json(options->encoder)},
-                              {"panel", options->panel},
-                              {"output_bits", options->output_bits}};
+                              {"decoder", fixed_decoder_json(fixed_config_of(*options))}};
       Json files = Json::array();
       OutputDir dir(*out);
       for (const VectorFile& f : set.files) {

@@ -1,6 +1,6 @@
 #include "run_report.hpp"
 
-#include "trm/encoder_json.hpp"
+#include "trm/decoder_json.hpp"
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
@@ -172,14 +172,12 @@ Json RunRecorder::report(double wall_seconds) const {
   p["size"] = {full_width_, full_height_};
   p["reduced_size"] = {reduced_width_, reduced_height_};
   p["refresh_hz"] = options_.refresh_hz;
-  p["encoder"] = encoder_json(options_.encoder);
-  p["output_bits"] = options_.output_bits;
-  p["sensitivity"] = options_.sensitivity;
-  p["panel"] = options_.panel;
+  // The headset side's whole configuration: the fixed-point formats too where a fixed-point decoder ran.
+  const FixedDecoderConfig decoder = fixed_config_of(options_);
+  p["decoder"] = options_.method_impl() == "reference" ? decoder_json(decoder.decoder) : fixed_decoder_json(decoder);
   p["method"] = options_.method;
   p["impl"] = options_.method_impl();
   p["seed"] = options_.seed;
-  if (options_.method_impl() != "reference") p["skip_unneeded"] = !options_.no_skip;
   r["parameters"] = p;
 
   Json s;
