@@ -9,6 +9,7 @@ shift || true
 packages=(
   build-essential cmake pkg-config
   libopencv-dev            # image/video I/O, reference filters (GaussianBlur, resize), DFT
+  libopencv-contrib-dev    # SSIM (the quality module) for the perceptual metrics
   libusb-1.0-0-dev         # USB bulk rig feeder
   libhidapi-dev            # HID rig feeder (hidraw + libusb backends)
   libgtest-dev libgmock-dev

@@ -3,6 +3,8 @@
 
 #include "trm/transfer.hpp"
 
+#include <opencv2/quality/qualityssim.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -88,6 +90,18 @@ CodeAgreement compare_codes(const cv::Mat& codes, const cv::Mat& reference_codes
   a.sum_lsb = cv::sum(flat)[0];
   a.sum_squared_lsb = cv::norm(flat, cv::NORM_L2SQR);
   return a;
+}
+
+double ssim_srgb(const cv::Mat& linear_a, const cv::Mat& linear_b) {
+  if (linear_a.size() != linear_b.size() || linear_a.type() != linear_b.type() || linear_a.empty()) {
+    throw std::invalid_argument("ssim_srgb: the two images must be non-empty, of the same size and type");
+  }
+  const cv::Mat a = to_encoded(linear_a, Transfer::Srgb) * 255.0;
+  const cv::Mat b = to_encoded(linear_b, Transfer::Srgb) * 255.0;
+  const cv::Scalar per_channel = cv::quality::QualitySSIM::compute(a, b, cv::noArray());
+  double sum = 0.0;
+  for (int c = 0; c < a.channels(); ++c) sum += per_channel[c];
+  return sum / a.channels();
 }
 
 std::optional<PairTracker::Pair> PairTracker::add(int eye, std::int64_t t, const cv::Mat& emitted,

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -164,6 +166,25 @@ TEST(ReferenceAgreementCriterion, TwoLsbFails) {
 
 TEST(ReferenceAgreementCriterion, NothingComparedFails) {
   EXPECT_FALSE(kReferenceAgreementCriterion.met_by(CodeAgreement{}));
+}
+
+// SSIM against Wang et al.'s formula on constant images, where the local statistics are exact: two constants mu_a,
+// mu_b give (2 mu_a mu_b + C1) / (mu_a^2 + mu_b^2 + C1), C1 = (0.01 * 255)^2.
+TEST(Ssim, MatchesTheDefinitionOnConstantImagesAndIsOneForIdenticalOnes) {
+  const double mu_a = 100.0, mu_b = 110.0;
+  const auto linear_of = [](double display) { return to_linear(display / 255.0, Transfer::Srgb); };
+  const cv::Mat a(24, 24, CV_64FC3, cv::Scalar::all(linear_of(mu_a)));
+  const cv::Mat b(24, 24, CV_64FC3, cv::Scalar::all(linear_of(mu_b)));
+  const double c1 = (0.01 * 255.0) * (0.01 * 255.0);
+  EXPECT_NEAR(ssim_srgb(a, b), (2 * mu_a * mu_b + c1) / (mu_a * mu_a + mu_b * mu_b + c1), 1e-9);
+  cv::Mat noise(24, 24, CV_64FC3);
+  cv::randu(noise, cv::Scalar::all(0.0), cv::Scalar::all(1.0));
+  EXPECT_NEAR(ssim_srgb(noise, noise), 1.0, 1e-12);
+  cv::Mat blurred;
+  cv::blur(noise, blurred, cv::Size(3, 3));
+  EXPECT_LT(ssim_srgb(noise, blurred), 0.9);
+  EXPECT_NEAR(ssim_srgb(noise, blurred), ssim_srgb(blurred, noise), 1e-12);
+  EXPECT_THROW(ssim_srgb(a, cv::Mat(24, 23, CV_64FC3, cv::Scalar::all(0.5))), std::invalid_argument);
 }
 
 }  // namespace

@@ -465,6 +465,8 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   EXPECT_EQ(by_method["half-rate"]["flicker_contrast"].get<double>(), 0.0);
   EXPECT_NEAR(by_method["bfi"]["flicker_contrast"].get<double>(), 1.0, 1e-12);
   EXPECT_EQ(by_method["full"]["energy_vs_full_rate"].get<double>(), 0.0);
+  EXPECT_GT(by_method["full"]["mean_pair_ssim"].get<double>(), by_method["bfi"]["mean_pair_ssim"].get<double>());
+  EXPECT_LE(by_method["full"]["mean_pair_ssim"].get<double>(), 1.0);
   EXPECT_GT(by_method["trm"]["energy_vs_full_rate"].get<double>(), 0.0);
   // Pursuit of the pan: the half-rate hold blurs more than full rate against continuous motion, black frames less.
   EXPECT_GT(report["eye"]["target_velocity_deg_s"].get<double>() * report["eye"]["target_velocity_deg_s"].get<double>(), 0.0);

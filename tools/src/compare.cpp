@@ -78,6 +78,7 @@ class MethodMeter {
     }
     if (const auto pair = pairs_.add(slot.eye, slot.index, shown.emitted_linear, reference)) {
       const double psnr = psnr_srgb(pair->perceived, pair->reference);
+      ssim_sum_ += ssim_srgb(pair->perceived, pair->reference);
       ++pair_count_;
       if (std::isfinite(psnr)) {
         psnr_sum_ += psnr;
@@ -109,6 +110,7 @@ class MethodMeter {
     m.mtcd = mtcd_steps_ > 0 ? mtcd_sum_ / mtcd_steps_ : 0.0;
     m.reference_mtcd = mtcd_steps_ > 0 ? reference_mtcd_sum_ / mtcd_steps_ : 0.0;
     m.pairs = pair_count_;
+    m.mean_pair_ssim = pair_count_ > 0 ? ssim_sum_ / static_cast<double>(pair_count_) : 0.0;
     // Every pair exact: +inf, as psnr_srgb says of one exact pair.
     m.mean_pair_psnr_db = finite_pairs_ > 0 ? psnr_sum_ / static_cast<double>(finite_pairs_)
                                            : (pair_count_ > 0 ? std::numeric_limits<double>::infinity() : 0.0);
@@ -149,7 +151,7 @@ class MethodMeter {
   double flicker_sum_ = 0, reference_flicker_sum_ = 0, flicker_lit_ = 0, reference_flicker_lit_ = 0;
   double mtcd_sum_ = 0, reference_mtcd_sum_ = 0;
   std::int64_t mtcd_steps_ = 0;
-  double psnr_sum_ = 0;
+  double psnr_sum_ = 0, ssim_sum_ = 0;
   std::int64_t pair_count_ = 0, finite_pairs_ = 0;
 };
 
@@ -178,6 +180,7 @@ const std::vector<Column>& columns() {
       {"MTCD", [](const MethodMeasure& m) { return number(m.mtcd, 3); }},
       {"MTCD (full rate)", [](const MethodMeasure& m) { return number(m.reference_mtcd, 3); }},
       {"pair PSNR dB", [](const MethodMeasure& m) { return number(m.mean_pair_psnr_db, 2); }},
+      {"pair SSIM", [](const MethodMeasure& m) { return number(m.mean_pair_ssim, 4); }},
       {"energy vs full rate", [](const MethodMeasure& m) { return number(m.energy_vs_full_rate, 2); }},
       {"energy vs continuous", [](const MethodMeasure& m) { return number(m.energy_vs_continuous, 2); }},
   };
@@ -361,7 +364,7 @@ std::string compare_csv(const CompareResult& result) {
   std::ostringstream out;
   out << "method,views,pixels_rendered_saved_percent,pixels_sent_saved_percent,mean_link_payload_bits,"
          "peak_link_wire_bits,link_fits,luminance_percent,flicker_contrast,reference_flicker_contrast,mtcd,"
-         "reference_mtcd,pairs,mean_pair_psnr_db,energy_vs_full_rate,energy_vs_continuous,seconds\n";
+         "reference_mtcd,pairs,mean_pair_psnr_db,mean_pair_ssim,energy_vs_full_rate,energy_vs_continuous,seconds\n";
   out.precision(10);
   for (const MethodMeasure& m : result.methods) {
     out << m.method << ',' << m.views << ',' << m.pixels_rendered_saved_percent << ',' << m.pixels_sent_saved_percent
@@ -369,7 +372,7 @@ std::string compare_csv(const CompareResult& result) {
         << m.luminance_percent << ',' << m.flicker_contrast << ',' << m.reference_flicker_contrast << ',' << m.mtcd
         << ',' << m.reference_mtcd << ',' << m.pairs << ','
         << (std::isinf(m.mean_pair_psnr_db) ? std::string("inf") : number(m.mean_pair_psnr_db, 6)) << ','
-        << m.energy_vs_full_rate << ',' << m.energy_vs_continuous << ',' << m.seconds << '\n';
+        << m.mean_pair_ssim << ',' << m.energy_vs_full_rate << ',' << m.energy_vs_continuous << ',' << m.seconds << '\n';
   }
   return out.str();
 }
@@ -411,6 +414,7 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
                        {"pairs", m.pairs},
                        {"mean_pair_psnr_db", finite(m.mean_pair_psnr_db)},
                        {"pairs_exact", std::isinf(m.mean_pair_psnr_db)},
+                       {"mean_pair_ssim", m.mean_pair_ssim},
                        {"energy_vs_full_rate", m.energy_vs_full_rate},
                        {"energy_vs_continuous", m.energy_vs_continuous},
                        {"seconds", m.seconds}});

@@ -46,6 +46,7 @@ struct MethodMeasure {
   // judder).
   double energy_vs_full_rate = 0.0;
   double energy_vs_continuous = 0.0;
+  double mean_pair_ssim = 0.0;                  // fixed gaze, against the full-rate reference pair (OpenCV quality)
   std::int64_t pairs = 0;
   double seconds = 0.0;                         // wall time of this method's run
 };

@@ -33,7 +33,7 @@ struct FixedDecoderConfig {
   // FixedFrameDecoder::decode(frame, taps) records the integer stages instead).
   DecoderConfig decoder;
 
-  // Why the defaults below are wider than natural content needs (docs/sweeps.md: F = 18..21, U weights 8 bits, an
+  // Why the defaults below are wider than natural content needs (docs/sweeps.md: F = 18..22, U weights 4 bits, an
   // 18-bit residual store meet >= 99.9 % identical on discs): the motion test amplifies the error of L_{t-1} and
   // alpha. alpha' = alpha + w rho with w = exp(-s c), c = |Yp - Ya| / (Yp + Ya), so an error e in Yp moves alpha' by
   // about s w |rho| e / (Yp + Ya), and the drive code by that times the panel's slope (x^(1/gamma) (2^o - 1) is

@@ -53,6 +53,11 @@ class PairTracker {
 // equally visible; +inf when the encodings are identical.
 double psnr_srgb(const cv::Mat& linear_a, const cv::Mat& linear_b);
 
+// SSIM (Wang et al. 2004, OpenCV's quality module: 11x11 Gaussian window, sigma 1.5, K1 = 0.01, K2 = 0.03) of two
+// linear-light images on their 8-bit-scale sRGB encodings (display values, as SSIM is defined on), the mean over
+// channels; 1 for identical images. Throws std::invalid_argument for images of different sizes or types.
+double ssim_srgb(const cv::Mat& linear_a, const cv::Mat& linear_b);
+
 // ---- output codes against the reference ----
 
 // Drive codes of a decoder against the reference's (rounded to the same output depth), over one or many views.
