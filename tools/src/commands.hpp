@@ -13,5 +13,6 @@ void register_hw_report(CLI::App& app, Action& action);
 void register_vectors(CLI::App& app, Action& action);
 void register_sweep(CLI::App& app, Action& action);
 void register_methods(CLI::App& app, Action& action);
+void register_bench(CLI::App& app, Action& action);
 
 }  // namespace trm::cli
