@@ -23,16 +23,50 @@ EyeState& FixedDecoderCore::begin(const LinkFrame& frame, const char* who) {
   return eye;
 }
 
-FrameOutput FixedDecoderCore::start_output(const LinkFrame& frame) const {
+namespace {
+
+// Held by its owner alone (the spare list): no returned frame, held output or concealment shares it.
+bool unshared(const cv::Mat& m) { return m.u != nullptr && m.u->refcount == 1; }
+
+}  // namespace
+
+cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type) {
+  for (const cv::Mat& spare : spares) {
+    if (spare.size() == size && spare.type() == type && unshared(spare)) return spare;
+  }
+  cv::Mat plane(size, type);
+  spares.push_back(plane);
+  return plane;
+}
+
+FrameOutput FixedDecoderCore::start_output(const LinkFrame& frame, EyeState& eye) const {
   FrameOutput out;
   const cv::Size full(frame.meta.full_width, frame.meta.full_height);
   out.frame.meta = frame.meta;
   out.frame.meta.width = full.width;
   out.frame.meta.height = full.height;
+  for (const DecodedFrame& spare : eye.spare_outputs) {
+    if (unshared(spare.wanted_linear) && unshared(spare.drive) && unshared(spare.drive_codes) &&
+        unshared(spare.emitted_linear)) {
+      out.frame.wanted_linear = spare.wanted_linear;
+      out.frame.drive = spare.drive;
+      out.frame.drive_codes = spare.drive_codes;
+      out.frame.emitted_linear = spare.emitted_linear;
+      return out;
+    }
+  }
   out.frame.wanted_linear.create(full, CV_64FC3);
   out.frame.drive.create(full, CV_64FC3);
   out.frame.drive_codes.create(full, CV_16UC3);
   out.frame.emitted_linear.create(full, CV_64FC3);
+  // Two in flight (the one returned and the held output) and one being filled cover a caller that keeps one view.
+  constexpr std::size_t kSpareOutputs = 3;
+  DecodedFrame spare;
+  spare.wanted_linear = out.frame.wanted_linear;
+  spare.drive = out.frame.drive;
+  spare.drive_codes = out.frame.drive_codes;
+  spare.emitted_linear = out.frame.emitted_linear;
+  if (eye.spare_outputs.size() < kSpareOutputs) eye.spare_outputs.push_back(std::move(spare));
   return out;
 }
 

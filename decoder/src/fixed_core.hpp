@@ -36,7 +36,14 @@ struct EyeState {
   std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
   DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
                              // view is lost
+  // Planes of earlier views (output, rho, d_t) kept for reuse: one that no caller holds any more is filled again, so
+  // a view in steady state allocates (and faults in) no frame-sized memory.
+  std::vector<DecodedFrame> spare_outputs;
+  std::vector<cv::Mat> spare_planes;
 };
+
+// A plane of `size` and `type` from `spares` that nothing else holds, else a new one (kept in `spares` for later).
+cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type);
 
 // The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
 // flags of its U source rows and the full frame's residual line flag.
@@ -72,8 +79,8 @@ class FixedDecoderCore {
                            detail::Concealment& out, const char* who);
   // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
   DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
-  // Allocates the output matrices at full size.
-  FrameOutput start_output(const LinkFrame& frame) const;
+  // The output matrices at full size: planes of an earlier view of the eye that no caller holds any more, else new.
+  FrameOutput start_output(const LinkFrame& frame, EyeState& eye) const;
   // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
   Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
   // Prepares the LCD frame stores of the eye for this frame (first frame: held history).

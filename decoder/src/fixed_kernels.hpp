@@ -4,9 +4,12 @@
 // Raw values are integers; each function states its Q formats. F = linear_frac_bits throughout.
 #pragma once
 
+#include "fixed_tables.hpp"
+
 #include "trm/fixed_decoder.hpp"
 #include "trm/lut.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -105,20 +108,48 @@ class FixedKernels {
   // The U functions return U's output: in the encoded space codes uQb.U (linear_of_upsampled applies the EOTF LUT);
   // in the linear space linear light uQ1.F, blended from lin(code) (linear_of_upsampled passes it through).
   // U: bilinear blend of reduced codes rows row0 (i0) and row1 (i1) at full column x, channel ch; codes uQb.U.
+  // (The per-sample stages are defined here, inline in the schedules' loops; the rest is in fixed_stages.cpp.)
   Raw upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col, Raw row_upper,
-               int ch) const;
+               int ch) const {
+    return blend(row0[3 * col.i0 + ch], row0[3 * col.i1 + ch], row1[3 * col.i0 + ch], row1[3 * col.i1 + ch],
+                 col.upper, row_upper);
+  }
   // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd); linear space: four codes through
   // the I ROM, result uQ1.F (Rnd).
-  Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
+  Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const {
+    if (linear_space_) return blend_linear(top_left, top_right, bottom_left, bottom_right, col_upper, row_upper);
+    const Raw unit = Raw{1} << config_.bilinear_weight_frac_bits;
+    const Raw top = (unit - col_upper) * top_left + col_upper * top_right;  // uQb.W
+    const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
+    const Raw blended = (unit - row_upper) * top + row_upper * bottom;  // uQb.2W
+    return fx::rounded_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_frac_bits,
+                             fx::Quant::Rnd);  // uQb.U
+  }
   // lin() of U's encoded output through the interpolated EOTF LUT; uQ1.F. Linear space: U's output as it is.
-  Raw linear_of_upsampled(Raw upsampled) const;
+  Raw linear_of_upsampled(Raw upsampled) const {
+    if (linear_space_) return upsampled;
+    // The top bits of U's output address the ROM node, the rest weigh the step to the next node (wider than the
+    // table's own input code, which stops at 24 bits).
+    const int weight_bits = config_.upsample_frac_bits - config_.eotf_segments_per_code_log2;
+    return eotf_->interpolate(static_cast<std::size_t>(upsampled >> weight_bits),
+                              static_cast<std::uint64_t>(upsampled & ((Raw{1} << weight_bits) - 1)), weight_bits);
+  }
 
   // Eq. 2: beta = 2 I - L (sQ3.F), shown = clamp(beta, 0, 1), rho = beta - shown.
   CompensatedSample compensate(Raw full_linear, Raw low_linear) const { return split(2 * full_linear - low_linear); }
   // shown = clamp(beta, 0, 1), rho = beta - shown. A concealed (lost) line of a full frame splits beta = L.
-  CompensatedSample split(Raw beta) const;
+  CompensatedSample split(Raw beta) const {
+    CompensatedSample out;
+    out.shown = std::clamp(beta, Raw{0}, one());
+    out.clipped = out.shown != beta;
+    out.rho = beta - out.shown;  // sQ2.F in [-1, 1]
+    return out;
+  }
   // rho (sQ.F) into the residual store format (its rounding and overflow modes).
-  StoredResidual store_residual(Raw rho) const;
+  StoredResidual store_residual(Raw rho) const {
+    if (rho == 0) return StoredResidual{};  // zero in every format (the common case: beta within [0, 1])
+    return store_nonzero_residual(rho);
+  }
 
   bool lcd() const { return lcd_; }
   // LCD (Eq. 7 inverse): the drive code whose merge with v_{t-1} = previous_code reaches m = ((x_t + x_{t-1})/2)^(1/g).
@@ -143,7 +174,9 @@ class FixedKernels {
   static std::uint8_t compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples);
 
   // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
-  std::uint16_t drive_code(Raw linear, int ch) const;
+  std::uint16_t drive_code(Raw linear, int ch) const {
+    return threshold_search(thresholds_[static_cast<std::size_t>(ch)], linear);  // o comparisons per sample
+  }
   // Drive value v = x^(1/gamma) for reports, uQ1.drive_frac_bits.
   Raw drive_value(Raw linear, int ch) const;
   // The light drive code `code` emits after `previous_code` (read only for a panel with history).
@@ -195,6 +228,8 @@ class FixedKernels {
   // c = difference / sum through the reciprocal LUT, clamped to 1; difference > 0.
   Raw contrast_of(Raw difference, Raw sum) const;
   Raw lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const;
+  Raw blend_linear(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
+  StoredResidual store_nonzero_residual(Raw rho) const;
 };
 
 }  // namespace trm::fixed_detail

@@ -38,52 +38,22 @@ std::uint16_t FixedKernels::encode_linear(Raw x) const {
   return threshold_search(encode_thresholds_, x);
 }
 
-Raw FixedKernels::blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper,
-                        Raw row_upper) const {
+Raw FixedKernels::blend_linear(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper,
+                               Raw row_upper) const {
   const Raw unit = Raw{1} << config_.bilinear_weight_frac_bits;
-  if (linear_space_) {
-    // U on linear light: the four codes through the I ROM (uQ1.F), result uQ1.F. The exact sum has 1 + F + 2W bits
-    // (77 at the defaults): a 128-bit accumulator.
-    using Wide = fx::detail::int128;
-    const Wide top = (unit - col_upper) * code_rom_[static_cast<std::size_t>(top_left)] +
-                     col_upper * code_rom_[static_cast<std::size_t>(top_right)];
-    const Wide bottom = (unit - col_upper) * code_rom_[static_cast<std::size_t>(bottom_left)] +
-                        col_upper * code_rom_[static_cast<std::size_t>(bottom_right)];
-    const int shift = 2 * config_.bilinear_weight_frac_bits;
-    return static_cast<Raw>(fx::rounded_shift((unit - row_upper) * top + row_upper * bottom, shift, fx::Quant::Rnd));
-  }
-  const Raw top = (unit - col_upper) * top_left + col_upper * top_right;            // uQb.W
-  const Raw bottom = (unit - col_upper) * bottom_left + col_upper * bottom_right;
-  const Raw blended = (unit - row_upper) * top + row_upper * bottom;               // uQb.2W
-  return fx::rounded_shift(blended, 2 * config_.bilinear_weight_frac_bits - config_.upsample_frac_bits, fx::Quant::Rnd);  // uQb.U
+  // U on linear light: the four codes through the I ROM (uQ1.F), result uQ1.F. The exact sum has 1 + F + 2W bits
+  // (77 at the defaults): a 128-bit accumulator.
+  using Wide = fx::detail::int128;
+  const Wide top = (unit - col_upper) * code_rom_[static_cast<std::size_t>(top_left)] +
+                   col_upper * code_rom_[static_cast<std::size_t>(top_right)];
+  const Wide bottom = (unit - col_upper) * code_rom_[static_cast<std::size_t>(bottom_left)] +
+                      col_upper * code_rom_[static_cast<std::size_t>(bottom_right)];
+  const int shift = 2 * config_.bilinear_weight_frac_bits;
+  return static_cast<Raw>(fx::rounded_shift((unit - row_upper) * top + row_upper * bottom, shift, fx::Quant::Rnd));
 }
 
-Raw FixedKernels::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const BilinearWeights& col,
-                           Raw row_upper, int ch) const {
-  return blend(row0[3 * col.i0 + ch], row0[3 * col.i1 + ch], row1[3 * col.i0 + ch], row1[3 * col.i1 + ch], col.upper,
-               row_upper);
-}
-
-Raw FixedKernels::linear_of_upsampled(Raw upsampled) const {
-  if (linear_space_) return upsampled;
-  // The top bits of U's output address the ROM node, the rest weigh the step to the next node (wider than the
-  // table's own input code, which stops at 24 bits).
-  const int weight_bits = config_.upsample_frac_bits - config_.eotf_segments_per_code_log2;
-  return eotf_->interpolate(static_cast<std::size_t>(upsampled >> weight_bits),
-                            static_cast<std::uint64_t>(upsampled & ((Raw{1} << weight_bits) - 1)), weight_bits);
-}
-
-CompensatedSample FixedKernels::split(Raw beta) const {
-  CompensatedSample out;
-  out.shown = std::clamp(beta, Raw{0}, one());
-  out.clipped = out.shown != beta;
-  out.rho = beta - out.shown;  // sQ2.F in [-1, 1]
-  return out;
-}
-
-StoredResidual FixedKernels::store_residual(Raw rho) const {
+StoredResidual FixedKernels::store_nonzero_residual(Raw rho) const {
   StoredResidual out;
-  if (rho == 0) return out;  // zero in every format (the common case: beta within [0, 1])
   fx::SaturationCounter saturation;
   out.value = fx::quantise_raw(rho, config_.linear_frac_bits, config_.residual, &saturation);
   out.saturated = saturation.overflows != 0;
@@ -226,11 +196,6 @@ WeightedSample FixedKernels::clamp_alpha(Raw alpha) const {
 
 std::uint8_t FixedKernels::compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples) {
   return std::equal(stored, stored + samples, received) ? kLineStatic : std::uint8_t{0};
-}
-
-std::uint16_t FixedKernels::drive_code(Raw linear, int ch) const {
-  // Binary search over the threshold ROM: o comparisons per sample.
-  return threshold_search(thresholds_[static_cast<std::size_t>(ch)], linear);
 }
 
 Raw FixedKernels::drive_value(Raw linear, int ch) const {

@@ -228,7 +228,7 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const de
   fixed_detail::FixedKernels& kernels = core_->kernels();
   const Geometry& g = kernels.geometry(eye.full_size);
   const StreamPlan plan = plan_for(g);
-  fixed_detail::FrameOutput out = core_->start_output(frame);
+  fixed_detail::FrameOutput out = core_->start_output(frame, eye);
   out.full = frame.meta.parity == Parity::Full;
   out.concealed_lines = lost != nullptr ? lost->lost_lines : 0;
   core_->begin_lcd(out, eye);
@@ -243,8 +243,8 @@ DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const de
     LineRing<std::uint16_t> delay("E_t delay", plan.delay_lines, full_samples);
     LineRing<Raw> gauss("vertical Gaussian", plan.gauss_lines, reduced_samples);
     LineRing<std::uint16_t> low_lines("U of d_t", plan.low_lines, reduced_samples);
-    cv::Mat residual_store(g.full, CV_32SC3);   // frame store rho
-    cv::Mat low_store(g.reduced, CV_16UC3);     // frame store d_t
+    cv::Mat residual_store = fixed_detail::reusable_plane(eye.spare_planes, g.full, CV_32SC3);  // frame store rho
+    cv::Mat low_store = fixed_detail::reusable_plane(eye.spare_planes, g.reduced, CV_16UC3);    // frame store d_t
     std::vector<const Raw*> tap_rows;
 
     full_frame_schedule(

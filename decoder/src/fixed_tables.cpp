@@ -17,7 +17,7 @@ fx::RuntimeFormat lcd_coefficient_format(int linear_frac_bits) {
   return fx::RuntimeFormat{7, linear_frac_bits, true, fx::Quant::Rnd, fx::Overflow::Sat};
 }
 
-std::uint16_t threshold_search(const std::vector<std::int64_t>& thresholds, std::int64_t x) {
+std::uint16_t threshold_search_generic(const std::vector<std::int64_t>& thresholds, std::int64_t x) {
   int lo = 0;
   int hi = static_cast<int>(thresholds.size()) - 1;
   while (lo < hi) {

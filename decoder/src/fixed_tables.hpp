@@ -20,7 +20,17 @@ fx::RuntimeFormat lcd_coefficient_format(int linear_frac_bits);
 
 // The largest code k with x >= T_k in an increasing threshold ROM (T_0 = 0, one word per code): the quantiser of a
 // threshold ROM, by binary search (log2 of the ROM size comparisons).
-std::uint16_t threshold_search(const std::vector<std::int64_t>& thresholds, std::int64_t x);
+// A ROM of 2^n words (every drive and link code ROM) is searched without branches: n halving steps, each adding its
+// step where x >= T, give the same k for a non-decreasing ROM (the generic search is kept for other sizes).
+std::uint16_t threshold_search_generic(const std::vector<std::int64_t>& thresholds, std::int64_t x);
+inline std::uint16_t threshold_search(const std::vector<std::int64_t>& thresholds, std::int64_t x) {
+  const std::size_t n = thresholds.size();
+  if ((n & (n - 1)) != 0) return threshold_search_generic(thresholds, x);
+  const std::int64_t* t = thresholds.data();
+  std::size_t k = 0;
+  for (std::size_t step = n / 2; step != 0; step /= 2) k += x >= t[k + step] ? step : 0;
+  return static_cast<std::uint16_t>(k);
+}
 
 // Largest-remainder rounding of non-negative weights (summing to ~1) to integers summing exactly to 2^frac_bits.
 // A mirror-symmetric weight list (taps centred on an integer or half-integer position) stays exactly symmetric:

@@ -15,7 +15,7 @@ namespace {
 constexpr int kMaxEntries = 1 << 16;
 constexpr int kMaxInputBits = 24;
 constexpr int kMaxOutputBits = 32;
-constexpr int kSegmentFracBits = 32;  // fractional bits of the segment position p
+constexpr int kSegmentFracBits = InterpolatedLut::kSegmentFracBits;
 
 [[noreturn]] void reject(const std::string& name, const std::string& why) {
   throw std::invalid_argument("trm::fx LUT '" + name + "': " + why);
@@ -77,6 +77,7 @@ InterpolatedLut::InterpolatedLut(std::string name, const LutShape& shape, double
     for (std::int64_t u = 0; u < codes; ++u) {
       rom_[static_cast<std::size_t>(u)] = rom_word(std::min(static_cast<double>(u) / input_span_, 1.0));
     }
+    set_fast_weight_bits();
     return;
   }
   const int segments = shape_.entries - 1;
@@ -102,6 +103,7 @@ InterpolatedLut::InterpolatedLut(std::string name, const LutShape& shape, double
         rom_[static_cast<std::size_t>(r * per_octave + j)] = rom_word(code / input_span_);
       }
     }
+    set_fast_weight_bits();
     return;
   }
   for (int j = 0; j <= segments; ++j) {
@@ -113,32 +115,23 @@ InterpolatedLut::InterpolatedLut(std::string name, const LutShape& shape, double
     reject(name_, "input span too wide or too narrow for the table size");
   }
   segment_step_ = static_cast<std::uint64_t>(step);
+  set_fast_weight_bits();
 }
 
-std::int64_t InterpolatedLut::evaluate_raw(std::uint32_t code) const {
-  const std::uint32_t top_code = (std::uint32_t{1} << shape_.input_bits) - 1u;
-  code = std::min(code, top_code);
-  if (direct_) return rom_[code];
-
-  if (shape_.octaves > 0) {
-    // Region by leading one: bottom region [0, 2^b) or octave [2^L, 2^(L+1)), each 2^scale codes.
-    const int leading_one = std::bit_width(code) - 1;
-    const bool bottom = leading_one < bottom_region_bits_;
-    const int scale_bits = bottom ? bottom_region_bits_ : leading_one;
-    const int region = bottom ? 0 : leading_one - bottom_region_bits_ + 1;
-    const std::uint64_t offset = bottom ? code : code - (std::uint64_t{1} << leading_one);
-    const std::uint64_t scaled = offset << segments_per_octave_log2_;  // offset·S
-    const std::size_t index = (static_cast<std::size_t>(region) << segments_per_octave_log2_) +
-                              static_cast<std::size_t>(scaled >> scale_bits);
-    return interpolate(index, scaled & ((std::uint64_t{1} << scale_bits) - 1u), scale_bits);
+void InterpolatedLut::set_fast_weight_bits() {
+  if (shape_.rounding != Quant::Rnd) return;
+  // |y0| < 2^M and |y1 - y0| < 2^D: y0 2^w and (y1 - y0) w stay below 2^(max(M, D) + w) <= 2^61, their sum and the
+  // rounding half below 2^63.
+  const auto bits_of = [](std::int64_t v) { return static_cast<int>(std::bit_width(static_cast<std::uint64_t>(v < 0 ? -v : v))); };
+  int widest = 0;
+  for (std::size_t i = 0; i < rom_.size(); ++i) {
+    widest = std::max(widest, bits_of(rom_[i]));
+    if (i + 1 < rom_.size()) widest = std::max(widest, bits_of(rom_[i + 1] - rom_[i]));
   }
-
-  const detail::uint128 position = static_cast<detail::uint128>(code) * segment_step_;
-  return interpolate(static_cast<std::size_t>(position >> kSegmentFracBits),
-                     static_cast<std::uint64_t>(position) & 0xffffffffu, kSegmentFracBits);
+  fast_weight_bits_ = 61 - widest;
 }
 
-std::int64_t InterpolatedLut::interpolate(std::size_t node, std::uint64_t weight, int weight_bits) const {
+std::int64_t InterpolatedLut::interpolate_wide(std::size_t node, std::uint64_t weight, int weight_bits) const {
   const std::size_t last = rom_.size() - 1;
   if (node >= last) return rom_[last];
   // y = rom[i] + (rom[i+1] − rom[i])·w, exact in units of 2^-weight_bits output LSB, then rounded once.

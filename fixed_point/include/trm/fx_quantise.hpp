@@ -211,6 +211,16 @@ constexpr detail::int128 rounded_shift(detail::int128 raw, int shift, Quant q) {
   return detail::quantise_only(raw, shift, 0, q).raw;
 }
 constexpr std::int64_t rounded_shift(std::int64_t raw, int shift, Quant q) {
+  // The two modes the decoder's hot stages use, on the 64-bit value itself: the floor is an arithmetic shift, the
+  // first dropped bit is bit shift - 1 of the two's complement pattern, the rest the bits below it (exactly as
+  // quantise_only decides, without its 128-bit detour).
+  if (shift >= 1 && shift <= 63 && (q == Quant::Rnd || q == Quant::RndConv)) {
+    const std::int64_t kept = raw >> shift;
+    const bool first_dropped = ((raw >> (shift - 1)) & 1) != 0;
+    if (q == Quant::Rnd) return kept + (first_dropped ? 1 : 0);
+    const bool rest_dropped = (raw & ((std::int64_t{1} << (shift - 1)) - 1)) != 0;
+    return kept + (first_dropped && (rest_dropped || (kept & 1) != 0) ? 1 : 0);
+  }
   return static_cast<std::int64_t>(rounded_shift(static_cast<detail::int128>(raw), shift, q));
 }
 

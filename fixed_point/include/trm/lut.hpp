@@ -31,6 +31,7 @@
 
 #include "trm/fx_quantise.hpp"
 
+#include <bit>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -60,6 +61,8 @@ struct RomSize {
 
 class InterpolatedLut {
  public:
+  static constexpr int kSegmentFracBits = 32;  // fractional bits of the uniform segment position p
+
   // Generic constructor: `function` maps the domain position t in [0, 1] to the output value.
   // `input_span` is the input code at t = 1 (> 0). Throws std::invalid_argument on a bad shape.
   InterpolatedLut(std::string name, const LutShape& shape, double input_span,
@@ -67,7 +70,26 @@ class InterpolatedLut {
 
   // Output raw value for input code u (codes >= 2^input_bits are a caller error: they are clamped
   // to the top code so the result stays defined).
-  std::int64_t evaluate_raw(std::uint32_t code) const;
+  std::int64_t evaluate_raw(std::uint32_t code) const {
+    const std::uint32_t top_code = (std::uint32_t{1} << shape_.input_bits) - 1u;
+    code = code < top_code ? code : top_code;
+    if (direct_) return rom_[code];
+    if (shape_.octaves > 0) {
+      // Region by leading one: bottom region [0, 2^b) or octave [2^L, 2^(L+1)), each 2^scale codes.
+      const int leading_one = std::bit_width(code) - 1;
+      const bool bottom = leading_one < bottom_region_bits_;
+      const int scale_bits = bottom ? bottom_region_bits_ : leading_one;
+      const int region = bottom ? 0 : leading_one - bottom_region_bits_ + 1;
+      const std::uint64_t offset = bottom ? code : code - (std::uint64_t{1} << leading_one);
+      const std::uint64_t scaled = offset << segments_per_octave_log2_;  // offset·S
+      const std::size_t index = (static_cast<std::size_t>(region) << segments_per_octave_log2_) +
+                                static_cast<std::size_t>(scaled >> scale_bits);
+      return interpolate(index, scaled & ((std::uint64_t{1} << scale_bits) - 1u), scale_bits);
+    }
+    const detail::uint128 position = static_cast<detail::uint128>(code) * segment_step_;
+    return interpolate(static_cast<std::size_t>(position >> kSegmentFracBits),
+                       static_cast<std::uint64_t>(position) & 0xffffffffu, kSegmentFracBits);
+  }
 
   // Output as a double (raw · 2^-output_frac_bits), for reports and tests.
   double evaluate(std::uint32_t code) const;
@@ -75,7 +97,18 @@ class InterpolatedLut {
   // The interpolation step of evaluate_raw on its own: rom[node] + (rom[node+1] − rom[node])·weight/2^weight_bits,
   // rounded once into the output format (nodes past the last return rom[N−1]). For a caller that computes the node
   // and a weight wider than this table's input code allows (weight_bits <= 62).
-  std::int64_t interpolate(std::size_t node, std::uint64_t weight, int weight_bits) const;
+  std::int64_t interpolate(std::size_t node, std::uint64_t weight, int weight_bits) const {
+    const std::size_t last = rom_.size() - 1;
+    if (node >= last) return rom_[last];
+    // Where the exact sum fits in 64 bits and the rounding is half up, the 128-bit quantiser reduces to
+    // add-half-and-shift; the result lies between two in-range ROM words, so saturation never acts.
+    if (weight_bits >= 1 && weight_bits <= fast_weight_bits_ && (weight >> weight_bits) == 0) {
+      const std::int64_t y0 = rom_[node];
+      const std::int64_t exact = y0 * (std::int64_t{1} << weight_bits) + (rom_[node + 1] - y0) * static_cast<std::int64_t>(weight);
+      return (exact + (std::int64_t{1} << (weight_bits - 1))) >> weight_bits;
+    }
+    return interpolate_wide(node, weight, weight_bits);
+  }
 
   // The domain position t the code stands for (the exact, real-valued mapping the table models).
   double position_of(std::uint32_t code) const { return static_cast<double>(code) / input_span_; }
@@ -96,6 +129,11 @@ class InterpolatedLut {
   int segments_per_octave_log2_;
   int bottom_region_bits_;      // the bottom octave region is [0, 2^bottom_region_bits_)
   std::vector<std::int64_t> rom_;
+  // The widest weight for which interpolate's exact sum and its rounding half fit in an int64 (-1: the rounding is
+  // not half up, every call takes interpolate_wide).
+  int fast_weight_bits_ = -1;
+  std::int64_t interpolate_wide(std::size_t node, std::uint64_t weight, int weight_bits) const;
+  void set_fast_weight_bits();
 };
 
 // sRGB EOTF (IEC 61966-2-1), encoded → linear on [0, 1]: x/12.92 below 0.04045,

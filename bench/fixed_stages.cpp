@@ -1,0 +1,202 @@
+// The fixed-point decoder's stage kernels one line at a time (2160-pixel lines, r = 1/2, default formats, vive OLED
+// unless named), so that a change in decode time points at its stage. Items are channel samples of the stage's output
+// (pixels for the per-pixel motion weight). The kernels are the schedules' own (fixed_kernels.hpp).
+#include "fixed_kernels.hpp"
+
+#include "trm/panel.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace {
+
+using trm::fixed_detail::FixedKernels;
+using trm::fixed_detail::Geometry;
+using trm::fixed_detail::Raw;
+
+constexpr int kWidth = 2160;
+constexpr int kHeight = 1200;
+
+trm::FixedDecoderConfig config_of(const char* panel) {
+  trm::FixedDecoderConfig config;
+  config.decoder.link.reduction = 0.5;
+  config.decoder.panel = trm::parse_panel(panel);
+  return config;
+}
+
+std::vector<std::uint16_t> random_codes(int samples, int top, std::uint64_t seed) {
+  cv::RNG rng(seed);
+  std::vector<std::uint16_t> codes(static_cast<std::size_t>(samples));
+  for (std::uint16_t& c : codes) c = static_cast<std::uint16_t>(rng.uniform(0, top + 1));
+  return codes;
+}
+
+std::vector<Raw> random_linear(int samples, Raw one, std::uint64_t seed) {
+  cv::RNG rng(seed);
+  std::vector<Raw> values(static_cast<std::size_t>(samples));
+  for (Raw& v : values) v = static_cast<Raw>(rng.uniform(0.0, 1.0) * static_cast<double>(one));
+  return values;
+}
+
+void BM_GaussianHorizontal(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const std::vector<std::uint16_t> line = random_codes(3 * kWidth, kernels.max_code(), 1);
+  std::vector<Raw> out(static_cast<std::size_t>(3 * g.reduced.width));
+  for (auto _ : state) {
+    for (int k = 0; k < g.reduced.width; ++k) {
+      for (int ch = 0; ch < 3; ++ch) {
+        out[static_cast<std::size_t>(3 * k + ch)] =
+            kernels.gaussian_horizontal(line.data(), g.gauss_cols[static_cast<std::size_t>(k)], ch);
+      }
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * g.reduced.width);
+}
+BENCHMARK(BM_GaussianHorizontal);
+
+void BM_GaussianVertical(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const int samples = 3 * g.reduced.width;
+  const auto& taps = g.gauss_rows[static_cast<std::size_t>(g.reduced.height / 2)];
+  std::vector<std::vector<Raw>> rows;
+  std::vector<const Raw*> pointers;
+  for (std::size_t j = 0; j < taps.weight.size(); ++j) {
+    rows.push_back(random_linear(samples, Raw{255} << 16, 10 + j));
+  }
+  for (const auto& r : rows) pointers.push_back(r.data());
+  std::vector<std::uint16_t> out(static_cast<std::size_t>(samples));
+  for (auto _ : state) {
+    for (int i = 0; i < samples; ++i) out[static_cast<std::size_t>(i)] = kernels.gaussian_vertical(pointers.data(), taps, i);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * samples);
+}
+BENCHMARK(BM_GaussianVertical);
+
+// U of two reduced rows and the EOTF LUT after it: L or alpha of one output line.
+void BM_UpsampleLinear(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const std::vector<std::uint16_t> row0 = random_codes(3 * g.reduced.width, kernels.max_code(), 2);
+  const std::vector<std::uint16_t> row1 = random_codes(3 * g.reduced.width, kernels.max_code(), 3);
+  const Raw row_upper = g.bilinear_rows[1].upper;
+  std::vector<Raw> out(static_cast<std::size_t>(3 * kWidth));
+  for (auto _ : state) {
+    for (int x = 0; x < kWidth; ++x) {
+      for (int ch = 0; ch < 3; ++ch) {
+        out[static_cast<std::size_t>(3 * x + ch)] = kernels.linear_of_upsampled(
+            kernels.upsample(row0.data(), row1.data(), g.bilinear_cols[static_cast<std::size_t>(x)], row_upper, ch));
+      }
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_UpsampleLinear);
+
+// Eq. 2 and the residual store: beta, shown, rho of one output line.
+void BM_CompensateAndStore(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> full = random_linear(3 * kWidth, kernels.one(), 4);
+  const std::vector<Raw> low = random_linear(3 * kWidth, kernels.one(), 5);
+  std::vector<std::int32_t> residual(static_cast<std::size_t>(3 * kWidth));
+  std::vector<Raw> shown(static_cast<std::size_t>(3 * kWidth));
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < full.size(); ++k) {
+      const auto s = kernels.compensate(full[k], low[k]);
+      shown[k] = s.shown;
+      residual[k] = static_cast<std::int32_t>(kernels.store_residual(s.rho).value);
+    }
+    benchmark::DoNotOptimize(residual.data());
+    benchmark::DoNotOptimize(shown.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_CompensateAndStore);
+
+// Eqs. 5-6 per pixel: luma of L_{t-1} and alpha, c through the reciprocal, w = exp(-s c).
+void BM_MotionWeight(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 6);
+  const std::vector<Raw> alpha = random_linear(3 * kWidth, kernels.one(), 7);
+  std::vector<Raw> weight(static_cast<std::size_t>(kWidth));
+  for (auto _ : state) {
+    for (int x = 0; x < kWidth; ++x) {
+      bool underflow = false;
+      weight[static_cast<std::size_t>(x)] = kernels.motion_weight(
+          kernels.luma(previous.data() + 3 * x), kernels.luma(alpha.data() + 3 * x), underflow);
+    }
+    benchmark::DoNotOptimize(weight.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kWidth);
+}
+BENCHMARK(BM_MotionWeight);
+
+// Eq. 4: alpha' = clamp(alpha + w rho).
+void BM_AddWeightedResidual(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> alpha = random_linear(3 * kWidth, kernels.one(), 8);
+  const std::vector<Raw> weight = random_linear(kWidth, kernels.one(), 9);
+  const std::vector<Raw> residual = random_linear(3 * kWidth, kernels.one() / 4, 10);
+  std::vector<Raw> out(static_cast<std::size_t>(3 * kWidth));
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      out[k] = kernels.add_weighted_residual(alpha[k], weight[k / 3], residual[k]).alpha_prime;
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_AddWeightedResidual);
+
+// OLED drive code (threshold ROM search) of one output line.
+void BM_OledDriveCode(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 11);
+  std::vector<std::uint16_t> codes(wanted.size());
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < wanted.size(); ++k) codes[k] = kernels.drive_code(wanted[k], static_cast<int>(k % 3));
+    benchmark::DoNotOptimize(codes.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_OledDriveCode);
+
+// The drive value v for reports (DecodedFrame::drive), not part of the hardware's output.
+void BM_OledDriveValue(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 12);
+  std::vector<Raw> values(wanted.size());
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < wanted.size(); ++k) values[k] = kernels.drive_value(wanted[k], static_cast<int>(k % 3));
+    benchmark::DoNotOptimize(values.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_OledDriveValue);
+
+// LCD drive (Eq. 7 inverse against v_{t-1}) of one output line.
+void BM_LcdDrive(benchmark::State& state) {
+  FixedKernels kernels(config_of("lcd"));
+  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 13);
+  const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 14);
+  const std::vector<std::uint16_t> previous_codes = random_codes(3 * kWidth, kernels.max_output_code(), 15);
+  std::vector<std::uint16_t> codes(wanted.size());
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < wanted.size(); ++k) {
+      codes[k] = kernels.lcd_drive(wanted[k], previous[k], previous_codes[k], false).code;
+    }
+    benchmark::DoNotOptimize(codes.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LcdDrive);
+
+}  // namespace

@@ -1,0 +1,64 @@
+// `trm bench --quick`: the JSON names every contender at every size and panel, and every figure is finite and
+// positive. No timing threshold: speed is the benchmark's figure, never a test's verdict.
+#include "trm_process.hpp"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <string>
+
+namespace {
+
+using trm::test::run_trm;
+using trm::test::ScratchDir;
+
+void expect_positive(const nlohmann::json& value, const std::string& what) {
+  ASSERT_TRUE(value.is_number()) << what;
+  const double v = value.get<double>();
+  EXPECT_TRUE(std::isfinite(v) && v > 0.0) << what << " = " << v;
+}
+
+TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
+  ScratchDir dir("trm_bench_");
+  const std::string json_path = dir.str("bench.json");
+  const auto result = run_trm("bench --quick --json " + json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("opencv-float32"), std::string::npos) << result.output;
+  std::ifstream in(json_path);
+  const nlohmann::json report = nlohmann::json::parse(in);
+  expect_positive(report["machine"]["hardware_threads"], "hardware_threads");
+  const nlohmann::json& results = report["results"];
+  ASSERT_TRUE(results.is_array());
+  ASSERT_EQ(results.size(), 4u);  // two sizes x (OLED, LCD)
+  std::set<std::string> panels;
+  for (const nlohmann::json& r : results) {
+    panels.insert(r["panel"].get<std::string>());
+    expect_positive(r["size"][0], "width");
+    expect_positive(r["size"][1], "height");
+    expect_positive(r["link_frames"], "link_frames");
+    expect_positive(r["output_mpix_per_frame"], "output_mpix_per_frame");
+    for (const char* field : {"on_chip_mib", "off_chip_mib", "output_frame_mib", "total_mib"}) {
+      expect_positive(r["hw_report_memory"][field], field);
+    }
+    std::set<std::string> names;
+    for (const nlohmann::json& d : r["decoders"]) {
+      const std::string name = d["name"].get<std::string>();
+      names.insert(name);
+      for (const char* field : {"threads", "mpix_per_s", "ms_per_frame", "ratio_to_opencv", "peak_rss_mib",
+                                "rss_before_mib"}) {
+        expect_positive(d[field], name + " " + field);
+      }
+      for (const char* hz : {"90", "120", "144"}) expect_positive(d["realtime_factor"][hz], name + " RT " + hz);
+      ASSERT_EQ(d["repeat_seconds"].size(), 2u) << name;
+      for (const nlohmann::json& s : d["repeat_seconds"]) expect_positive(s, name + " repeat");
+    }
+    EXPECT_EQ(names, (std::set<std::string>{"fixed", "fixed-frame", "reference", "opencv-float32"}));
+  }
+  EXPECT_EQ(panels, (std::set<std::string>{"vive", "lcd"}));
+}
+
+}  // namespace

@@ -1,0 +1,292 @@
+// `trm bench`: decode throughput of the streaming and frame fixed-point decoders, the double reference and an OpenCV
+// float32 decoder of the same per-pair math (bench/opencv_pipeline), in one process, repeats interleaved, on the same
+// encoded views at headset sizes, beside the resource report's memory (issue 13).
+#include "commands.hpp"
+#include "hw_report.hpp"
+
+#include "opencv_trm.hpp"
+
+#include "trm/atomic_file.hpp"
+#include "trm/decoder.hpp"
+#include "trm/encoder.hpp"
+#include "trm/fixed_decoder.hpp"
+#include "trm/scene.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+namespace trm::cli {
+
+namespace {
+
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr double kRates[] = {90.0, 120.0, 144.0};
+
+struct BenchSize {
+  int width;
+  int height;
+  bool stereo;
+  std::string label() const {
+    return std::to_string(width) + "x" + std::to_string(height) + (stereo ? " x2 stereo" : "");
+  }
+};
+
+struct BenchOptions {
+  bool quick = false;
+  int repeats = 0;  // 0: 3, or 2 with --quick
+  int pairs = 0;    // frame pairs per repeat; 0: 2, or 1 with --quick
+  std::string scene = "panorama";
+  std::string json;
+  std::vector<std::string> sizes;   // WxH or WxHs (stereo); empty: the headset sizes
+  std::vector<std::string> panels;  // empty: vive and lcd
+};
+
+BenchSize parse_bench_size(const std::string& text) {
+  const bool stereo = !text.empty() && text.back() == 's';
+  const std::string dims = stereo ? text.substr(0, text.size() - 1) : text;
+  const std::size_t x = dims.find('x');
+  int width = 0;
+  int height = 0;
+  try {
+    if (x == std::string::npos) throw std::invalid_argument(text);
+    std::size_t used_w = 0;
+    std::size_t used_h = 0;
+    width = std::stoi(dims.substr(0, x), &used_w);
+    height = std::stoi(dims.substr(x + 1), &used_h);
+    if (used_w != x || used_h != dims.size() - x - 1) throw std::invalid_argument(text);
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--size '" + text + "': expected WxH, or WxHs for a stereo pair of WxH views");
+  }
+  if (width < 2 || height < 2 || width > 8192 || height > 8192) {
+    throw std::invalid_argument("--size '" + text + "': each side must be in [2, 8192]");
+  }
+  return {width, height, stereo};
+}
+
+// A field of /proc/self/status in kB (VmRSS, VmHWM); 0 where it cannot be read.
+double status_kib(const std::string& field) {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind(field + ":", 0) == 0) return std::stod(line.substr(field.size() + 1));
+  }
+  return 0.0;
+}
+
+// Starts a new peak of the resident set (Linux: "5" into clear_refs resets VmHWM to VmRSS); false where it cannot,
+// and then the peak is the process's own (getrusage).
+bool reset_peak() {
+  std::ofstream clear("/proc/self/clear_refs");
+  clear << "5";
+  clear.flush();
+  return static_cast<bool>(clear);
+}
+
+double peak_mib() {
+  const double hwm = status_kib("VmHWM");
+  if (hwm > 0.0) return hwm / 1024.0;
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// One contender: a fresh decoder per repeat (built outside the timing), decoding every view in order.
+struct Contender {
+  std::string name;
+  int threads = 1;
+  std::function<std::function<void(const LinkFrame&)>()> make;
+  std::vector<double> seconds;  // per repeat
+  double peak_rss_mib = 0.0;
+  double rss_before_mib = 0.0;
+};
+
+FixedDecoderConfig config_for(const BenchSize& size, const std::string& panel) {
+  FixedDecoderConfig config;
+  config.decoder.link.reduction = 0.5;
+  config.decoder.link.stereo = size.stereo;
+  config.decoder.panel = parse_panel(panel);
+  return config;
+}
+
+std::vector<LinkFrame> encode_views(const BenchSize& size, const BenchOptions& options,
+                                    const EncoderConfig& link) {
+  SceneParams params;
+  params.width = size.width;
+  params.height = size.height;
+  params.supersample = 1;
+  const auto scene = make_scene(options.scene, params);
+  const TrmEncoder encoder(link);
+  std::vector<LinkFrame> views;
+  const int frames = 2 * options.pairs;
+  for (int t = 0; t < frames; ++t) {
+    const cv::Mat linear = scene->linear_frame(t);
+    for (int eye = 0; eye < (size.stereo ? 2 : 1); ++eye) views.push_back(encoder.encode(linear, t, eye));
+  }
+  return views;
+}
+
+Json hardware_memory(const FixedDecoderConfig& config, const BenchSize& size) {
+  const FixedStreamingDecoder decoder(config);
+  const Json hw = hardware_json(decoder.report(cv::Size(size.width, size.height)));
+  const Json& totals = hw["totals"];
+  const int eyes = size.stereo ? 2 : 1;
+  const double on_chip = eyes * static_cast<double>(totals["on_chip_bits"].get<std::int64_t>()) / 8.0 / kMiB;
+  const double off_chip = eyes * static_cast<double>(totals["off_chip_bits"].get<std::int64_t>()) / 8.0 / kMiB;
+  const double output = eyes * 3.0 * size.width * size.height * config.decoder.output_bits / 8.0 / kMiB;
+  return {{"on_chip_mib", on_chip}, {"off_chip_mib", off_chip}, {"output_frame_mib", output},
+          {"total_mib", on_chip + off_chip + output}};
+}
+
+Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptions& options, std::ostream& text) {
+  const FixedDecoderConfig config = config_for(size, panel);
+  const std::vector<LinkFrame> views = encode_views(size, options, config.decoder.link);
+  std::vector<Contender> contenders;
+  for (const char* impl : {"fixed", "fixed-frame", "reference"}) {
+    contenders.push_back({impl, 1,
+                          [impl, &config] {
+                            std::shared_ptr<HeadsetDecoder> d = make_decoder(impl, config);
+                            return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
+                          },
+                          {}, 0.0, 0.0});
+  }
+  contenders.push_back({"opencv-float32", cv::getNumThreads(),
+                        [&config] {
+                          auto d = std::make_shared<bench::OpencvTrmDecoder>(config.decoder);
+                          return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
+                        },
+                        {}, 0.0, 0.0});
+  const int repeats = options.repeats;
+  for (int repeat = 0; repeat < repeats; ++repeat) {
+    // Interleaved, the order rotating per repeat, so that no contender always runs first (cold) or last.
+    for (std::size_t k = 0; k < contenders.size(); ++k) {
+      Contender& c = contenders[(k + static_cast<std::size_t>(repeat)) % contenders.size()];
+      auto decode = c.make();
+      const bool measure_memory = repeat == 0;
+      if (measure_memory) {
+        c.rss_before_mib = status_kib("VmRSS") / 1024.0;
+        reset_peak();
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      for (const LinkFrame& view : views) decode(view);
+      c.seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      if (measure_memory) c.peak_rss_mib = peak_mib();
+    }
+  }
+  const double link_frames = static_cast<double>(views.size()) / (size.stereo ? 2.0 : 1.0);
+  const double frame_pixels = static_cast<double>(size.width) * size.height * (size.stereo ? 2.0 : 1.0);
+  const double opencv_seconds = median(contenders.back().seconds);
+  Json result = {{"size", {size.width, size.height}},
+                 {"stereo", size.stereo},
+                 {"panel", panel},
+                 {"link_frames", link_frames},
+                 {"output_mpix_per_frame", frame_pixels / 1e6},
+                 {"hw_report_memory", hardware_memory(config, size)}};
+  text << "\n" << size.label() << ", " << panel << ", r = 0.5, " << options.scene << ", "
+       << static_cast<int>(link_frames) << " frames, median of " << repeats << "\n";
+  text << "  " << std::left << std::setw(16) << "decoder" << std::right << std::setw(9) << "Mpix/s" << std::setw(11)
+       << "ms/frame" << std::setw(10) << "vs cv" << std::setw(9) << "RT@90" << std::setw(9) << "RT@120"
+       << std::setw(9) << "RT@144" << std::setw(9) << "threads" << std::setw(11) << "peak MiB" << "\n";
+  Json decoders = Json::array();
+  for (const Contender& c : contenders) {
+    const double seconds = median(c.seconds);
+    const double mpix_per_s = frame_pixels * link_frames / seconds / 1e6;
+    const double ms_per_frame = 1e3 * seconds / link_frames;
+    Json realtime = Json::object();
+    for (double hz : kRates) realtime[std::to_string(static_cast<int>(hz))] = mpix_per_s * 1e6 / (frame_pixels * hz);
+    decoders.push_back({{"name", c.name},
+                        {"threads", c.threads},
+                        {"mpix_per_s", mpix_per_s},
+                        {"ms_per_frame", ms_per_frame},
+                        {"ratio_to_opencv", opencv_seconds / seconds},
+                        {"realtime_factor", realtime},
+                        {"peak_rss_mib", c.peak_rss_mib},
+                        {"rss_before_mib", c.rss_before_mib},
+                        {"repeat_seconds", c.seconds}});
+    text << "  " << std::left << std::setw(16) << c.name << std::right << std::fixed << std::setprecision(2)
+         << std::setw(9) << mpix_per_s << std::setw(11) << ms_per_frame << std::setw(10) << opencv_seconds / seconds
+         << std::setprecision(3) << std::setw(9) << realtime["90"].get<double>() << std::setw(9)
+         << realtime["120"].get<double>() << std::setw(9) << realtime["144"].get<double>() << std::setw(9)
+         << c.threads << std::setprecision(1) << std::setw(11) << c.peak_rss_mib << "\n";
+  }
+  const Json& hw = result["hw_report_memory"];
+  text << "  hw-report memory: " << std::fixed << std::setprecision(1) << hw["on_chip_mib"].get<double>()
+       << " MiB on chip + " << hw["off_chip_mib"].get<double>() << " MiB off chip + "
+       << hw["output_frame_mib"].get<double>() << " MiB output drive codes = " << hw["total_mib"].get<double>()
+       << " MiB (peak RSS includes the process, the encoded views and the returned double planes)\n";
+  result["decoders"] = std::move(decoders);
+  return result;
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app, Action& action) {
+  auto options = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Time the fixed-point decoders (streaming, frame), the double reference and an OpenCV float32 "
+               "decoder of the same math at headset sizes, r = 1/2, OLED and LCD");
+  cmd->add_flag("--quick", options->quick, "Small and fast (CI): 96x64 stereo and 128x96, 1 pair, 2 repeats");
+  cmd->add_option("--repeats", options->repeats, "Timed repeats per contender, interleaved (default 3)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--pairs", options->pairs, "Frame pairs decoded per repeat (default 2)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--scene", options->scene, "Scene to encode")->capture_default_str();
+  cmd->add_option("--json", options->json, "Also write the figures as JSON to FILE");
+  cmd->add_option("--size", options->sizes,
+                  "View size WxH, or WxHs for a stereo pair (repeatable; default 1080x1200s 2160x1200 2880x1600)");
+  cmd->add_option("--panel", options->panels, "Panel (repeatable; default vive and lcd)");
+  cmd->callback([options, &action] {
+    action = [options] {
+      BenchOptions o = *options;
+      if (o.repeats == 0) o.repeats = o.quick ? 2 : 3;
+      if (o.pairs == 0) o.pairs = o.quick ? 1 : 2;
+      if (!o.json.empty()) io::check_file_target(o.json);
+      std::vector<BenchSize> sizes = o.quick ? std::vector<BenchSize>{{96, 64, true}, {128, 96, false}}
+                                             : std::vector<BenchSize>{{1080, 1200, true}, {2160, 1200, false},
+                                                                      {2880, 1600, false}};
+      if (!o.sizes.empty()) {
+        sizes.clear();
+        for (const std::string& text : o.sizes) sizes.push_back(parse_bench_size(text));
+      }
+      const std::vector<std::string> panels =
+          o.panels.empty() ? std::vector<std::string>{"vive", "lcd"} : o.panels;
+      for (const std::string& panel : panels) parse_panel(panel);  // rejected before any work
+      double load[3] = {0.0, 0.0, 0.0};
+      if (getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = 0.0;
+      Json report = {{"machine", {{"hardware_threads", std::thread::hardware_concurrency()},
+                                  {"load_average_at_start", {load[0], load[1], load[2]}}}},
+                     {"parameters", {{"reduction", 0.5}, {"scene", o.scene}, {"pairs", o.pairs},
+                                     {"repeats", o.repeats}, {"quick", o.quick}}}};
+      Json results = Json::array();
+      std::cout << "trm bench: " << std::thread::hardware_concurrency() << " hardware threads, load average "
+                << load[0] << " at start; OpenCV threads " << cv::getNumThreads() << "\n";
+      for (const BenchSize& size : sizes) {
+        for (const std::string& panel : panels) results.push_back(bench_one(size, panel, o, std::cout));
+      }
+      report["results"] = std::move(results);
+      if (!o.json.empty()) io::write_file_atomically(o.json, report.dump(2) + "\n");
+      return 0;
+    };
+  });
+}
+
+}  // namespace trm::cli
