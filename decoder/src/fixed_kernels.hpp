@@ -175,7 +175,7 @@ class FixedKernels {
 
   // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
   std::uint16_t drive_code(Raw linear, int ch) const {
-    return threshold_search(thresholds_[static_cast<std::size_t>(ch)], linear);  // o comparisons per sample
+    return drive_index_[static_cast<std::size_t>(ch)].search(linear);  // o comparisons per sample in hardware
   }
   // Drive value v = x^(1/gamma) for reports, uQ1.drive_frac_bits.
   Raw drive_value(Raw linear, int ch) const;
@@ -209,6 +209,7 @@ class FixedKernels {
   Raw sensitivity_raw_ = 0;
   bool sensitivity_infinite_ = false;
   std::array<std::vector<Raw>, 3> thresholds_;  // T_k, k = 0..2^o - 1 (T_0 = 0)
+  std::array<ThresholdIndex, 3> drive_index_;   // the same search over thresholds_, faster
   std::array<std::unique_ptr<fx::InterpolatedLut>, 3> drive_luts_;
   int drive_lut_shift_ = 0;  // linear LSBs dropped to address the drive LUT (24 address bits at most)
   std::optional<PanelEmission> emission_;  // built once the configuration is valid

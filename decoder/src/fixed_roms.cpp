@@ -127,6 +127,7 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
       t[static_cast<std::size_t>(k)] =
           static_cast<Raw>(std::ceil(std::ldexp(panel.linear_from_drive((k - 0.5) / top, ch), F)));
     }
+    drive_index_[static_cast<std::size_t>(ch)] = ThresholdIndex(t, F + 1);  // x in [0, 1] is uQ1.F
     fx::LutShape drive_shape;
     drive_shape.input_bits = drive_address_bits;
     drive_shape.octaves = drive_address_bits;

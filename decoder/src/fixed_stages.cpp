@@ -165,8 +165,13 @@ Raw FixedKernels::contrast_of(Raw difference, Raw sum) const {
   // Eq. 5: c = difference / sum = difference * mantissa 2^-24 2^-e, uQ1.F (clamped to 1 against LUT error).
   const fx::NormalisedReciprocal reciprocal =
       fx::reciprocal_normalised(*reciprocal_, static_cast<std::uint64_t>(sum), config_.linear_frac_bits);
-  const fx::detail::int128 product = static_cast<fx::detail::int128>(difference) * reciprocal.mantissa_raw;
   const int shift = reciprocal_->shape().output_frac_bits + reciprocal.exponent;
+  Raw narrow = 0;
+  if (!__builtin_mul_overflow(difference, reciprocal.mantissa_raw, &narrow)) {
+    // The exact product fits in 64 bits (at the default formats always: 30 x 26 bits); the rounding is the same.
+    return std::min(fx::rounded_shift(narrow, shift, fx::Quant::Rnd), one());
+  }
+  const fx::detail::int128 product = static_cast<fx::detail::int128>(difference) * reciprocal.mantissa_raw;
   const fx::detail::int128 c128 = fx::rounded_shift(product, shift, fx::Quant::Rnd);
   return static_cast<Raw>(std::min<fx::detail::int128>(c128, one()));
 }

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <stdexcept>
 
 namespace trm::fixed_detail {
@@ -25,6 +27,33 @@ std::uint16_t threshold_search_generic(const std::vector<std::int64_t>& threshol
     if (x >= thresholds[static_cast<std::size_t>(mid)]) lo = mid; else hi = mid - 1;
   }
   return static_cast<std::uint16_t>(lo);
+}
+
+ThresholdIndex::ThresholdIndex(std::vector<std::int64_t> thresholds, int value_bits)
+    : thresholds_(std::move(thresholds)), value_bits_(value_bits) {
+  if (value_bits <= kMantissaBits || value_bits > 40 || thresholds_.empty()) return;
+  const std::size_t buckets = static_cast<std::size_t>(value_bits - kMantissaBits + 1) << kMantissaBits;
+  base_.resize(buckets);
+  int steps = 0;
+  for (std::size_t b = 0; b < buckets; ++b) {
+    std::int64_t lo = static_cast<std::int64_t>(b);
+    std::int64_t hi = lo;
+    if (b >= (std::size_t{1} << kMantissaBits)) {
+      const int lead = static_cast<int>(b >> kMantissaBits) + kMantissaBits - 1;
+      const std::int64_t mantissa = static_cast<std::int64_t>(b & ((std::size_t{1} << kMantissaBits) - 1));
+      lo = ((std::int64_t{1} << kMantissaBits) + mantissa) << (lead - kMantissaBits);
+      hi = lo + (std::int64_t{1} << (lead - kMantissaBits)) - 1;
+    }
+    base_[b] = threshold_search(thresholds_, lo);
+    steps = std::max(steps, static_cast<int>(threshold_search(thresholds_, hi)) - static_cast<int>(base_[b]));
+  }
+  if (steps > kMaxSteps) {
+    base_.clear();
+    return;
+  }
+  padded_ = thresholds_;
+  padded_.insert(padded_.end(), kMaxSteps + 1, std::numeric_limits<std::int64_t>::max());
+  steps_ = std::max(steps, 1);
 }
 
 std::vector<std::int64_t> integer_weights(const std::vector<double>& weights, int frac_bits, const char* stage) {

@@ -5,6 +5,7 @@
 #include "trm/fixed_runtime.hpp"
 #include "trm/transfer.hpp"
 
+#include <bit>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,6 +32,39 @@ inline std::uint16_t threshold_search(const std::vector<std::int64_t>& threshold
   for (std::size_t step = n / 2; step != 0; step /= 2) k += x >= t[k + step] ? step : 0;
   return static_cast<std::uint16_t>(k);
 }
+
+// threshold_search's result, found faster for the simulation (the modelled hardware still searches the ROM; its
+// report is unchanged): a small index addressed like a float, by the leading-one position of x and the kMantissaBits
+// bits below it, gives the code at the lower end of x's bucket; the few thresholds inside the bucket (at most
+// kMaxSteps, checked at construction) are then compared in turn. Values outside [0, 2^value_bits) and ROMs whose
+// buckets hold more thresholds fall back to threshold_search.
+class ThresholdIndex {
+ public:
+  static constexpr int kMantissaBits = 7;
+  static constexpr int kMaxSteps = 4;
+  ThresholdIndex() = default;
+  ThresholdIndex(std::vector<std::int64_t> thresholds, int value_bits);
+  std::uint16_t search(std::int64_t x) const {
+    const auto u = static_cast<std::uint64_t>(x);
+    if (steps_ == 0 || (u >> value_bits_) != 0) return threshold_search(thresholds_, x);
+    std::size_t k = base_[bucket_of(u)];
+    for (int i = 0; i < steps_; ++i) k += x >= padded_[k + 1] ? 1 : 0;
+    return static_cast<std::uint16_t>(k);
+  }
+
+ private:
+  static std::size_t bucket_of(std::uint64_t u) {
+    const int lead = static_cast<int>(std::bit_width(u)) - 1;
+    if (lead < kMantissaBits) return static_cast<std::size_t>(u);
+    const std::size_t octave = static_cast<std::size_t>(lead - kMantissaBits + 1);
+    return (octave << kMantissaBits) + static_cast<std::size_t>((u >> (lead - kMantissaBits)) & ((1u << kMantissaBits) - 1));
+  }
+  std::vector<std::int64_t> thresholds_;
+  std::vector<std::int64_t> padded_;  // the thresholds, then kMaxSteps words that no x reaches
+  std::vector<std::uint16_t> base_;   // code at each bucket's lower end
+  int value_bits_ = 0;
+  int steps_ = 0;                     // 0: not usable
+};
 
 // Largest-remainder rounding of non-negative weights (summing to ~1) to integers summing exactly to 2^frac_bits.
 // A mirror-symmetric weight list (taps centred on an integer or half-integer position) stays exactly symmetric:
