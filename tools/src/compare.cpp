@@ -66,10 +66,12 @@ class MethodMeter {
     luma_sum_ += cv::sum(luma_emitted)[0];
     reference_luma_sum_ += cv::sum(luma_reference)[0];
 
+    const cv::Mat display = display_values(shown.emitted_linear);
+    const cv::Mat reference_display = display_values(reference);
     Eye& eye = eyes_[slot.eye];
     if (eye.t == slot.index - 1) {
-      mtcd_sum_ += mtcd({eye.display, display_values(shown.emitted_linear)});
-      reference_mtcd_sum_ += mtcd({eye.reference_display, display_values(reference)});
+      mtcd_sum_ += mtcd({eye.display, display});
+      reference_mtcd_sum_ += mtcd({eye.reference_display, reference_display});
       ++mtcd_steps_;
       if (slot.index % 2 == 1) {
         flicker_sum_ += alternation_contrast_sum(eye.luma, luma_emitted, flicker_lit_);
@@ -92,8 +94,8 @@ class MethodMeter {
     eye.t = slot.index;
     eye.luma = luma_emitted;
     eye.reference_luma = luma_reference;
-    eye.display = display_values(shown.emitted_linear);
-    eye.reference_display = display_values(reference);
+    eye.display = display;
+    eye.reference_display = reference_display;
   }
 
   // The scan line's x-t images (rows: frames of eye 0, steady levels the frames drive) and the scene's line at t = 0.
