@@ -178,4 +178,17 @@ double visual_difference_energy(const cv::Mat& l_a, const cv::Mat& l_b, double p
       kVisualDifferenceBeta);
 }
 
+double temporal_alias_energy(const cv::Mat& l, double pixels_per_degree, double samples_per_second,
+                             double retinal_velocity_deg_s) {
+  require_image("temporal_alias_energy", "l", l, Range::NonNegative);
+  require_sampling("temporal_alias_energy", pixels_per_degree, samples_per_second, retinal_velocity_deg_s);
+  const double adaptation = cv::mean(l)[0];
+  if (adaptation <= 0.0) return 0.0;
+  cv::Mat still;
+  cv::reduce(l, still, 0, cv::REDUCE_AVG, CV_64F);
+  const cv::Mat contrast = (l - cv::repeat(still, l.rows, 1)) / adaptation;
+  return pooled_unchecked(weighted_unchecked(contrast, pixels_per_degree, samples_per_second, retinal_velocity_deg_s),
+                          kVisualDifferenceBeta);
+}
+
 }  // namespace trm

@@ -472,6 +472,36 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   EXPECT_GT(report["eye"]["target_velocity_deg_s"].get<double>() * report["eye"]["target_velocity_deg_s"].get<double>(), 0.0);
   EXPECT_GT(by_method["half-rate"]["energy_vs_continuous"].get<double>(), by_method["full"]["energy_vs_continuous"].get<double>());
   EXPECT_LT(by_method["bfi"]["energy_vs_continuous"].get<double>(), by_method["full"]["energy_vs_continuous"].get<double>());
+  // The panorama's line has no sharp edge: no blur figure rather than the width of a texture's gradient.
+  EXPECT_TRUE(report["eye"]["continuous_blur_arcmin"].is_null());
+  for (const auto& [name, m] : by_method) {
+    EXPECT_TRUE(m["motion_blur_arcmin"].is_null()) << name;
+    EXPECT_GE(m["judder"].get<double>(), 0.0) << name;
+    // Fig. 12 of every method: four panels of the x-t view, written whole.
+    const cv::Mat figure = cv::imread(tmp.str("cmp/fig12_" + name + ".png"), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(figure.empty()) << name;
+    EXPECT_EQ(figure.channels(), 3) << name;
+    EXPECT_GT(figure.cols, 4 * figure.rows / 4) << name;
+  }
+  // Flicker at fixed gaze: black frames flicker more visibly than anything else, and up to a higher refresh rate.
+  for (const char* other : {"trm", "full", "half-rate", "ncsfi"}) {
+    EXPECT_GT(by_method["bfi"]["flicker_visibility"].get<double>(), by_method[other]["flicker_visibility"].get<double>()) << other;
+  }
+  EXPECT_EQ(by_method["half-rate"]["flicker_visibility"].get<double>(), 0.0);
+  EXPECT_GT(by_method["bfi"]["flicker_invisible_from_hz"].get<double>(), by_method["full"]["flicker_invisible_from_hz"].get<double>());
+  // Blur under exact pursuit of a disc's sharp edge: the repeat holds it twice as long as full rate, black frames
+  // do not lengthen a flash; no method is sharper than the disc moving continuously.
+  const Result discs = run_trm("compare --methods full,half-rate,bfi --scene discs --size 216x120 --frames 8 --out " +
+                               tmp.str("discs"));
+  ASSERT_EQ(discs.exit_code, 0) << discs.output;
+  std::ifstream in_discs(tmp.str("discs/report.json"));
+  const nlohmann::json disc_report = nlohmann::json::parse(in_discs);
+  std::map<std::string, double> blur;
+  for (const auto& m : disc_report["methods"]) blur[m["method"].get<std::string>()] = m["motion_blur_arcmin"].get<double>();
+  const double continuous_blur = disc_report["eye"]["continuous_blur_arcmin"].get<double>();
+  EXPECT_GT(blur["half-rate"], 1.5 * blur["full"]);
+  EXPECT_NEAR(blur["bfi"], blur["full"], 0.05);
+  for (const auto& [name, width] : blur) EXPECT_GE(width, continuous_blur - 1e-9) << name;
   // A subset runs only what is asked (full rate still measured as the reference, not listed).
   const Result two = run_trm("compare --methods trm,bfi --scene panorama --size 64x48 --frames 4 --out " + tmp.str("two"));
   ASSERT_EQ(two.exit_code, 0) << two.output;

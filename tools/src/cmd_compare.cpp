@@ -41,11 +41,14 @@ void register_compare(CLI::App& app, Action& action) {
       dir.write_text("compare.md", compare_markdown(result));
       dir.write_text("compare.csv", compare_csv(result));
       dir.write_text("report.json", compare_json(result).dump(2) + "\n");
+      for (std::size_t i = 0; i < result.figures.size(); ++i) {
+        if (!result.figures[i].empty()) dir.write_png(figure_name(result.methods[i].method), result.figures[i]);
+      }
       dir.commit();
       std::cout << "trm compare: " << (options->pipeline.input.empty() ? options->pipeline.scene : options->pipeline.input)
                 << ", " << result.size.width << "x" << result.size.height << ", " << frames << " frames\n"
                 << compare_table(result) << "  wrote " << dir.target().string()
-                << "/ (compare.md, compare.csv, report.json)\n";
+                << "/ (compare.md, compare.csv, report.json, fig12_<method>.png)\n";
       return 0;
     };
   });

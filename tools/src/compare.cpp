@@ -1,8 +1,10 @@
 #include "compare.hpp"
 
 #include "pipeline.hpp"
+#include "xt_figure.hpp"
 
 #include "trm/encoder_json.hpp"
+#include "trm/flicker.hpp"
 #include "trm/metrics.hpp"
 #include "trm/mtcd.hpp"
 #include "trm/panel_light.hpp"
@@ -45,11 +47,19 @@ double alternation_contrast_sum(const cv::Mat& luma_a, const cv::Mat& luma_b, do
 // Kim et al.'s MTCD is defined on display colour values: the 8-bit sRGB encoding of the light.
 cv::Mat display_values(const cv::Mat& linear) { return to_encoded(linear, Transfer::Srgb) * 255.0; }
 
+// The widest 10-90 % edge (pixels, as the scene renders it) that motion blur is measured on.
+constexpr double kSharpEdgeMaxPx = 3.0;
+
 // The running figures of one method's run, per view in slot order.
 class MethodMeter {
  public:
-  MethodMeter(const Panel& panel, int output_bits, int scan_line)
-      : panel_(panel), output_bits_(output_bits), scan_line_(scan_line), pairs_(panel) {}
+  MethodMeter(const Panel& panel, int output_bits, int scan_line, double pixels_per_degree, double refresh_hz)
+      : panel_(panel),
+        output_bits_(output_bits),
+        scan_line_(scan_line),
+        refresh_hz_(refresh_hz),
+        pairs_(panel),
+        flicker_(pixels_per_degree) {}
 
   void add(const DecodedView& view) {
     const DecodedFrame& shown = *view.decoded;
@@ -76,6 +86,7 @@ class MethodMeter {
       if (slot.index % 2 == 1) {
         flicker_sum_ += alternation_contrast_sum(eye.luma, luma_emitted, flicker_lit_);
         reference_flicker_sum_ += alternation_contrast_sum(eye.reference_luma, luma_reference, reference_flicker_lit_);
+        if (slot.eye == 0) flicker_.add_pair(eye.luma, luma_emitted);
       }
     }
     if (const auto pair = pairs_.add(slot.eye, slot.index, shown.emitted_linear, reference)) {
@@ -112,6 +123,8 @@ class MethodMeter {
     m.mtcd = mtcd_steps_ > 0 ? mtcd_sum_ / mtcd_steps_ : 0.0;
     m.reference_mtcd = mtcd_steps_ > 0 ? reference_mtcd_sum_ / mtcd_steps_ : 0.0;
     m.pairs = pair_count_;
+    m.flicker_visibility = flicker_.visibility(refresh_hz_);
+    m.flicker_invisible_from_hz = flicker_.invisible_from_hz();
     m.mean_pair_ssim = pair_count_ > 0 ? ssim_sum_ / static_cast<double>(pair_count_) : 0.0;
     // Every pair exact: +inf, as psnr_srgb says of one exact pair.
     m.mean_pair_psnr_db = finite_pairs_ > 0 ? psnr_sum_ / static_cast<double>(finite_pairs_)
@@ -143,7 +156,9 @@ class MethodMeter {
   const Panel& panel_;
   int output_bits_;
   int scan_line_;
+  double refresh_hz_;
   PairTracker pairs_;
+  FlickerSpectrum flicker_;
   std::vector<cv::Mat> levels_;
   cv::Mat profile_;
   std::map<int, Eye> eyes_;
@@ -159,6 +174,7 @@ class MethodMeter {
 
 std::string number(double v, int digits) {
   if (std::isinf(v)) return "exact";
+  if (std::isnan(v)) return "-";
   char text[64];
   std::snprintf(text, sizeof text, "%.*f", digits, v);
   return text;
@@ -179,6 +195,12 @@ const std::vector<Column>& columns() {
       {"luminance %", [](const MethodMeasure& m) { return number(m.luminance_percent, 1); }},
       {"flicker", [](const MethodMeasure& m) { return number(m.flicker_contrast, 4); }},
       {"flicker (full rate)", [](const MethodMeasure& m) { return number(m.reference_flicker_contrast, 4); }},
+      {"flicker JND", [](const MethodMeasure& m) { return number(m.flicker_visibility, 3); }},
+      {"flicker-free from Hz", [](const MethodMeasure& m) {
+         return std::isinf(m.flicker_invisible_from_hz) ? std::string("> 480") : number(m.flicker_invisible_from_hz, 0);
+       }},
+      {"blur arcmin", [](const MethodMeasure& m) { return number(m.motion_blur_arcmin, 2); }},
+      {"judder", [](const MethodMeasure& m) { return number(m.judder, 2); }},
       {"MTCD", [](const MethodMeasure& m) { return number(m.mtcd, 3); }},
       {"MTCD (full rate)", [](const MethodMeasure& m) { return number(m.reference_mtcd, 3); }},
       {"pair PSNR dB", [](const MethodMeasure& m) { return number(m.mean_pair_psnr_db, 2); }},
@@ -190,6 +212,12 @@ const std::vector<Column>& columns() {
 }
 
 }  // namespace
+
+std::string figure_name(const std::string& method) {
+  std::string name = method;
+  std::replace(name.begin(), name.end(), ':', '-');
+  return "fig12_" + name + ".png";
+}
 
 std::vector<std::string> CompareOptions::chosen_methods() const {
   if (!methods.empty()) return methods;
@@ -237,12 +265,16 @@ CompareResult run_compare(const CompareOptions& options,
   const Motion motion = source->motion(0);
   double target_px_s = motion.global_velocity_px_s[0];
   result.scan_line = source->height() / 2;
+  // The target's columns at t = 0: its bounds, or the whole line for a global motion.
+  double target_left = 0.0, target_right = source->width();
   if (target_px_s == 0.0) {
     for (const MotionObject& object : motion.objects) {
       if (std::abs(object.velocity_px_s[0]) > std::abs(target_px_s)) {
         target_px_s = object.velocity_px_s[0];
         const double centre = object.bounds.y + 0.5 * object.bounds.height;
         result.scan_line = std::clamp(static_cast<int>(centre), 0, source->height() - 1);
+        target_left = object.bounds.x;
+        target_right = object.bounds.x + object.bounds.width;
       }
     }
   }
@@ -268,7 +300,7 @@ CompareResult run_compare(const CompareOptions& options,
     run.impl_given = false;
     run.compare_reference = false;
     if (run.link_preset.empty()) run.link_preset = "dp1.4";  // bandwidth per link frame for every method
-    MethodMeter meter(run.panel, run.output_bits, result.scan_line);
+    MethodMeter meter(run.panel, run.output_bits, result.scan_line, viewer.pixels_per_degree, run.refresh_hz);
     MethodMeasure measure;
     measure.method = spec;
     double payload_sum = 0.0;
@@ -300,6 +332,53 @@ CompareResult run_compare(const CompareOptions& options,
   // which every method shares, is not counted as an artefact. It runs first, listed or not.
   cv::Mat full_levels;
   const MethodMeasure full_rate = run_method("full", full_levels);
+  // The columns the figures show: the target's path over the run, centred; the blur is measured around the
+  // steepest edge of the target's line at t = 0, over the monotone run of the line that holds it, widened by the
+  // blur and shift a frame-based display can add (three frames of travel).
+  const int line_width = profile.empty() ? 0 : profile.cols;
+  const double duration_s = static_cast<double>(frames) / options.pipeline.refresh_hz;
+  result.window_width = std::min(192, line_width);
+  const double path_centre = 0.5 * (target_left + target_right) + 0.5 * target_px_s * duration_s;
+  result.window_begin =
+      std::clamp(static_cast<int>(std::lround(path_centre)) - result.window_width / 2, 0,
+                 std::max(0, line_width - result.window_width));
+  int blur_begin = 0, blur_end = 0;      // [begin, end) of the line where the edge's width is measured
+  int judder_begin = 0, judder_end = 0;  // the target's columns, with the same margin
+  if (line_width >= 2) {
+    const auto* line = profile.ptr<double>(0);
+    const int search_begin = std::clamp(static_cast<int>(std::floor(target_left)) - 2, 0, line_width - 2);
+    const int search_end = std::clamp(static_cast<int>(std::ceil(target_right)) + 2, search_begin + 1, line_width - 1);
+    int edge = search_begin;
+    for (int x = search_begin; x < search_end; ++x) {
+      if (std::abs(line[x + 1] - line[x]) > std::abs(line[edge + 1] - line[edge])) edge = x;
+    }
+    const double rise = line[edge + 1] - line[edge];
+    const double tolerance = 1e-3 * std::abs(rise);
+    int begin = edge, end = edge + 1;
+    while (begin > 0 && (line[begin] - line[begin - 1]) * (rise > 0 ? 1 : -1) >= -tolerance) --begin;
+    while (end + 1 < line_width && (line[end + 1] - line[end]) * (rise > 0 ? 1 : -1) >= -tolerance) ++end;
+    const int margin = static_cast<int>(std::ceil(3.0 * std::abs(target_px_s) / options.pipeline.refresh_hz)) + 4;
+    blur_begin = std::max(0, begin - margin);
+    blur_end = std::min(line_width, end + 1 + margin);
+    judder_begin = static_cast<int>(std::floor(target_left)) - margin;
+    judder_end = static_cast<int>(std::ceil(target_right)) + margin;
+  }
+  const auto edge_arcmin = [&](const cv::Mat& row) {
+    if (blur_end - blur_begin < 2) return std::numeric_limits<double>::quiet_NaN();
+    try {
+      return pixels_to_arcmin(edge_width_px(row.colRange(blur_begin, blur_end).clone()), viewer);
+    } catch (const std::invalid_argument&) {
+      return std::numeric_limits<double>::quiet_NaN();  // no edge on the target's line
+    }
+  };
+  result.continuous_blur_arcmin = line_width >= 2 ? edge_arcmin(profile) : std::numeric_limits<double>::quiet_NaN();
+  // A soft gradient of a texture is no edge to measure blur on: the widths are NaN unless the target's own edge is
+  // sharp.
+  if (!(result.continuous_blur_arcmin <= pixels_to_arcmin(kSharpEdgeMaxPx, viewer))) {
+    blur_begin = blur_end = 0;
+    result.continuous_blur_arcmin = std::numeric_limits<double>::quiet_NaN();
+  }
+  const Gaze exact_pursuit = Gaze::perfect_pursuit(result.target_velocity_deg_s);
   for (const std::string& spec : methods) {
     cv::Mat levels;
     MethodMeasure measure = spec == "full" ? full_rate : run_method(spec, levels);
@@ -313,6 +392,29 @@ CompareResult run_compare(const CompareOptions& options,
           visual_difference_energy(seen, full_rate_seen, viewer.pixels_per_degree, xt_rate, lag);
       measure.energy_vs_continuous =
           visual_difference_energy(seen, continuous, viewer.pixels_per_degree, xt_rate, lag);
+      // Judder from frame to frame: one sample per frame (the frame's light integrated), so the panel's own pulse
+      // within a frame, which every method shares, is not counted; what is left is where each frame puts the target.
+      RetinaOptions per_frame = retina;
+      per_frame.substeps = 1;
+      // Only the target's own columns (in its frame they stay where it stood at t = 0): other objects on the line
+      // move in that frame, and their motion is no alias.
+      const cv::Mat per_frame_seen = target_frame_xt(levels, light, viewer, gaze, per_frame);
+      const cv::Range target_columns(std::max(0, judder_begin), std::min(per_frame_seen.cols, judder_end));
+      measure.judder = target_columns.size() >= 2
+                           ? temporal_alias_energy(per_frame_seen.colRange(target_columns).clone(),
+                                                   viewer.pixels_per_degree, xt_samples_per_second(light, 1), lag)
+                           : 0.0;
+      measure.motion_blur_arcmin =
+          edge_arcmin(retinal_row(levels, light, viewer, exact_pursuit.eye_velocity_deg_s, retina));
+      XtFigureInput figure{spec + ": " + (options.pipeline.input.empty() ? options.pipeline.scene : options.pipeline.input) +
+                               ", target " + number(result.target_velocity_deg_s, 1) + " deg/s, eye " +
+                               number(gaze.eye_velocity_deg_s, 1) + " deg/s, " +
+                               number(options.pipeline.refresh_hz, 0) + " Hz, row " + std::to_string(result.scan_line),
+                           levels, light, viewer, gaze, retina, result.window_begin, result.window_width};
+      result.figures.push_back(xt_figure(figure));
+    } else {
+      measure.motion_blur_arcmin = std::numeric_limits<double>::quiet_NaN();
+      result.figures.emplace_back();
     }
     result.methods.push_back(std::move(measure));
   }
@@ -349,7 +451,11 @@ std::string compare_markdown(const CompareResult& result) {
       << (p.link_preset.empty() ? "dp1.4" : p.link_preset) << ". Fractions against full-rate rendering of the same "
       << "frames; flicker and pair PSNR at a fixed gaze (Talbot-Plateau); the energies (supplement Eqs. 1-4) for an eye "
       << "pursuing the target at " << number(result.target_velocity_deg_s, 2) << " deg/s along row " << result.scan_line
-      << " at " << number(result.pixels_per_degree, 2) << " ppd, " << result.substeps << " sub-frame steps.\n\n|";
+      << " at " << number(result.pixels_per_degree, 2) << " ppd, " << result.substeps << " sub-frame steps. "
+      << "Flicker JND: the stCSF-weighted alternation at " << number(p.refresh_hz / 2.0, 1) << " Hz (1 = threshold of "
+      << "a flickering grating filling the view; trm/flicker.hpp); blur: 10-90 % width of the target's steepest edge "
+      << "under exact pursuit (the target moving continuously: " << number(result.continuous_blur_arcmin, 2)
+      << " arcmin); judder: the energy of the temporal aliases in the target's frame. Figures: fig12_<method>.png.\n\n|";
   for (const Column& c : columns()) out << " " << c.header << " |";
   out << "\n|";
   for (std::size_t i = 0; i < columns().size(); ++i) out << (i == 0 ? "---|" : "---:|");
@@ -366,7 +472,8 @@ std::string compare_csv(const CompareResult& result) {
   std::ostringstream out;
   out << "method,views,pixels_rendered_saved_percent,pixels_sent_saved_percent,mean_link_payload_bits,"
          "peak_link_wire_bits,link_fits,luminance_percent,flicker_contrast,reference_flicker_contrast,mtcd,"
-         "reference_mtcd,pairs,mean_pair_psnr_db,mean_pair_ssim,energy_vs_full_rate,energy_vs_continuous,seconds\n";
+         "reference_mtcd,pairs,mean_pair_psnr_db,mean_pair_ssim,energy_vs_full_rate,energy_vs_continuous,"
+         "flicker_visibility,flicker_invisible_from_hz,motion_blur_arcmin,judder,seconds\n";
   out.precision(10);
   for (const MethodMeasure& m : result.methods) {
     out << m.method << ',' << m.views << ',' << m.pixels_rendered_saved_percent << ',' << m.pixels_sent_saved_percent
@@ -374,7 +481,9 @@ std::string compare_csv(const CompareResult& result) {
         << m.luminance_percent << ',' << m.flicker_contrast << ',' << m.reference_flicker_contrast << ',' << m.mtcd
         << ',' << m.reference_mtcd << ',' << m.pairs << ','
         << (std::isinf(m.mean_pair_psnr_db) ? std::string("inf") : number(m.mean_pair_psnr_db, 6)) << ','
-        << m.mean_pair_ssim << ',' << m.energy_vs_full_rate << ',' << m.energy_vs_continuous << ',' << m.seconds << '\n';
+        << m.mean_pair_ssim << ',' << m.energy_vs_full_rate << ',' << m.energy_vs_continuous << ','
+        << m.flicker_visibility << ',' << m.flicker_invisible_from_hz << ',' << m.motion_blur_arcmin << ',' << m.judder
+        << ',' << m.seconds << '\n';
   }
   return out.str();
 }
@@ -397,7 +506,11 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
               {"scan_line", result.scan_line},
               {"target_velocity_deg_s", result.target_velocity_deg_s},
               {"eye_velocity_deg_s", eye_velocity_deg_s(result.target_velocity_deg_s)},
-              {"substeps", result.substeps}};
+              {"substeps", result.substeps},
+              {"continuous_blur_arcmin", std::isfinite(result.continuous_blur_arcmin)
+                                             ? nlohmann::ordered_json(result.continuous_blur_arcmin)
+                                             : nlohmann::ordered_json(nullptr)},
+              {"window", {result.window_begin, result.window_width}}};
   nlohmann::ordered_json methods = nlohmann::ordered_json::array();
   for (const MethodMeasure& m : result.methods) {
     const auto finite = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
@@ -419,6 +532,10 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
                        {"mean_pair_ssim", m.mean_pair_ssim},
                        {"energy_vs_full_rate", m.energy_vs_full_rate},
                        {"energy_vs_continuous", m.energy_vs_continuous},
+                       {"flicker_visibility", m.flicker_visibility},
+                       {"flicker_invisible_from_hz", finite(m.flicker_invisible_from_hz)},
+                       {"motion_blur_arcmin", finite(m.motion_blur_arcmin)},
+                       {"judder", m.judder},
                        {"seconds", m.seconds}});
   }
   j["methods"] = methods;

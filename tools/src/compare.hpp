@@ -47,6 +47,18 @@ struct MethodMeasure {
   double energy_vs_full_rate = 0.0;
   double energy_vs_continuous = 0.0;
   double mean_pair_ssim = 0.0;                  // fixed gaze, against the full-rate reference pair (OpenCV quality)
+  // Fixed gaze, trm/flicker.hpp: the stCSF-weighted alternation of eye 0's pairs at this refresh rate (1 = the
+  // threshold of a view-filling flickering grating), and the refresh rate from which it is invisible (+inf: still
+  // visible at 480 Hz).
+  double flicker_visibility = 0.0;
+  double flicker_invisible_from_hz = 0.0;
+  // The 10-90 % width of the target's steepest edge on the retina of an eye pursuing it exactly, time-averaged over
+  // the run (the hold-type blur: speed x the time a pixel is lit), in arcmin; NaN when the target's line has no
+  // sharp edge (textures: the steepest step of the line wider than 3 pixels).
+  double motion_blur_arcmin = 0.0;
+  // Judder: temporal_alias_energy (visual_difference.hpp) of the target-frame x-t image sampled once per frame
+  // (each frame's light integrated): where successive frames put the pursued target.
+  double judder = 0.0;
   std::int64_t pairs = 0;
   double seconds = 0.0;                         // wall time of this method's run
 };
@@ -58,8 +70,14 @@ struct CompareResult {
   int scan_line = 0;                  // the row the eye model follows the target along
   double target_velocity_deg_s = 0.0; // horizontal speed of the pursued target
   int substeps = 0;
+  double continuous_blur_arcmin = 0.0;  // motion_blur_arcmin of the target moving continuously (its own edge)
+  int window_begin = 0, window_width = 0;  // the scan line's columns the figures show and the blur is measured in
   std::vector<MethodMeasure> methods;
+  std::vector<cv::Mat> figures;  // per method: the Fig. 12 view (xt_figure.hpp), RGB CV_8UC3; empty: no x-t image
 };
+
+// The file name of a method's figure: "fig12_" + the method with ':' as '-' + ".png".
+std::string figure_name(const std::string& method);
 
 // Runs every chosen method in turn; progress(done, total) after each view (total views over all methods).
 CompareResult run_compare(const CompareOptions& options,

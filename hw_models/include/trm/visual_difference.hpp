@@ -63,4 +63,15 @@ double pooled_energy(const cv::Mat& normalised_contrast, double beta = kVisualDi
 double visual_difference_energy(const cv::Mat& l_a, const cv::Mat& l_b, double pixels_per_degree,
                                 double samples_per_second, double retinal_velocity_deg_s);
 
+// Judder: the energy of what changes over time in an x–t image taken in the target's frame. Continuous motion
+// pursued in that frame is still, so this is the energy of the temporal aliases a frame-based display adds (the
+// replicas of Fig. 12's Fourier view, off the ν = 0 line), through Eqs. 2 and 4 at the lag's retinal velocity. The
+// contrast is the change against each column's time average l̄ in units of the image's mean luminance L̄
+// (Weber contrast at the region's adaptation level), C = (l − l̄) / L̄, rather than Eq. 1's (l − l̄) / (l + l̄): Eq. 1
+// divides by the local luminance, which on a dark background turns the sub-pixel phase differences in an edge's
+// dark tail into contrasts near 1. 0 for a still or a black image. Uniform flicker (ρ = 0) adds nothing, as in
+// Eq. 2. Same arguments and errors as visual_difference_energy.
+double temporal_alias_energy(const cv::Mat& l, double pixels_per_degree, double samples_per_second,
+                             double retinal_velocity_deg_s);
+
 }  // namespace trm
