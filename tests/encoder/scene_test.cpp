@@ -219,6 +219,37 @@ TEST(Jitter, MovesByTinyRandomAmountsAndReportsIt) {
   EXPECT_LT(change, 0.5);
 }
 
+TEST(Scenes, MotionScaleRunsEveryMotionThatManyTimesAsFast) {
+  for (const std::string name : {"discs", "line", "zoneplate", "text", "panorama"}) {
+    SceneParams fast = small_params(40, 24);
+    fast.motion_scale = 2.0;
+    auto scaled = make_scene(name, fast);
+    auto native = make_scene(name, small_params(40, 24));
+    // Frame t at twice the speed is frame 2t of the scene (to the rounding of t / refresh x 2 against 2t / refresh).
+    for (const std::int64_t t : {1, 3}) EXPECT_LT(max_diff(scaled->linear_frame(t), native->linear_frame(2 * t)), 1e-9) << name;
+    const Motion a = scaled->motion(2), b = native->motion(4);
+    EXPECT_NEAR(a.global_velocity_px_s[0], 2.0 * b.global_velocity_px_s[0], 1e-9) << name;
+    ASSERT_EQ(a.objects.size(), b.objects.size()) << name;
+    for (std::size_t i = 0; i < a.objects.size(); ++i) {
+      EXPECT_NEAR(a.objects[i].velocity_px_s[0], 2.0 * b.objects[i].velocity_px_s[0], 1e-9) << name;
+    }
+    SceneParams frozen = small_params(40, 24);
+    frozen.motion_scale = 0.0;
+    auto still = make_scene(name, frozen);
+    EXPECT_EQ(max_diff(still->linear_frame(5), still->linear_frame(0)), 0.0) << name;
+  }
+  for (const std::string name : {"static", "checker", "flash", "jitter"}) {
+    SceneParams p = small_params(8, 8);
+    p.motion_scale = 2.0;
+    EXPECT_THROW(make_scene(name, p), std::invalid_argument) << name;
+  }
+  SceneParams bad = small_params(8, 8);
+  bad.motion_scale = std::nan("");
+  EXPECT_THROW(make_scene("discs", bad), std::invalid_argument);
+  bad.motion_scale = -1.0;
+  EXPECT_THROW(make_scene("discs", bad), std::invalid_argument);
+}
+
 TEST(StaticScene, ShowsTheGivenImageInLinearLight) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("trm_static_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

@@ -26,6 +26,8 @@ void register_compare(CLI::App& app, Action& action) {
   cmd->add_option("--viewer", options->viewer, "Eye's pixels per degree from a headset preset: vive, rift, monitor")
       ->capture_default_str();
   cmd->add_option("--ppd", options->ppd, "Pixels per degree (instead of --viewer's)");
+  cmd->add_option("--speed", options->speed_deg_s,
+                  "Speed of the pursued target in deg/s (every motion of the scene scaled alike; default: the scene's)");
   cmd->add_option("--substeps", options->substeps, "Retinal sub-frame steps S (default 16, docs/eye_model.md)");
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   cmd->callback([options, out, &action] {

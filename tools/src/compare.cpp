@@ -232,6 +232,14 @@ void CompareOptions::validate() const {
     throw std::invalid_argument("--ppd must be a finite number of pixels per degree > 0");
   }
   if (substeps < 0) throw std::invalid_argument("--substeps must be >= 1 (leave it out for the default)");
+  if (speed_deg_s) {
+    if (!(std::isfinite(*speed_deg_s) && *speed_deg_s >= 0.0)) {
+      throw std::invalid_argument("--speed must be a finite speed >= 0 deg/s");
+    }
+    if (!pipeline.input.empty()) {
+      throw std::invalid_argument("--speed applies to the built-in scenes, not to --input (its motion is recorded)");
+    }
+  }
   try {
     (void)viewer_preset(viewer);
   } catch (const std::invalid_argument& e) {
@@ -262,6 +270,7 @@ CompareResult run_compare(const CompareOptions& options,
   // The pursued target: the scene's global motion, else its fastest object; the eye follows it along the row
   // through its centre at t = 0. Inputs without known motion are watched at a fixed gaze.
   const std::unique_ptr<FrameSource> source = options.pipeline.open_source();
+  PipelineOptions shown = options.pipeline;  // what every method runs on: the scene at the asked speed
   const Motion motion = source->motion(0);
   double target_px_s = motion.global_velocity_px_s[0];
   result.scan_line = source->height() / 2;
@@ -279,6 +288,17 @@ CompareResult run_compare(const CompareOptions& options,
     }
   }
   const Viewer viewer = options.ppd ? custom_viewer(*options.ppd) : viewer_preset(options.viewer);
+  if (options.speed_deg_s) {
+    if (target_px_s == 0.0) {
+      throw std::invalid_argument("--speed: scene '" + options.pipeline.scene + "' has no moving target to set the "
+                                  "speed of");
+    }
+    const double native_deg_s = std::abs(target_px_s) / viewer.pixels_per_degree;
+    shown.motion_scale = *options.speed_deg_s / native_deg_s;
+    target_px_s *= shown.motion_scale;
+    result.motion_scale = shown.motion_scale;
+    (void)shown.open_source();  // the scene accepts the scale (throws its own message otherwise)
+  }
   result.pixels_per_degree = viewer.pixels_per_degree;
   result.target_velocity_deg_s = target_px_s / viewer.pixels_per_degree;
   result.substeps = options.substeps > 0 ? options.substeps : kDefaultRetinaSubsteps;
@@ -293,7 +313,7 @@ CompareResult run_compare(const CompareOptions& options,
   cv::Mat profile;  // the scan line of the scene at t = 0: what moves continuously in the ideal reference
   // One method's run: its measures, and its scan line's x-t levels for the pursuit energies.
   const auto run_method = [&](const std::string& spec, cv::Mat& levels) {
-    PipelineOptions run = options.pipeline;
+    PipelineOptions run = shown;
     run.method = spec;
     // Every method is judged in linear light (DESIGN §9): the double-precision headset side for all of them.
     run.impl = "reference";
@@ -496,6 +516,7 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
                      {"size", {result.size.width, result.size.height}},
                      {"frames", p.frames > 0 ? p.frames : p.default_frames},
                      {"refresh_hz", p.refresh_hz},
+                     {"motion_scale", result.motion_scale},
                      {"encoder", encoder_json(p.encoder)},
                      {"output_bits", p.output_bits},
                      {"sensitivity", p.sensitivity},

@@ -19,6 +19,7 @@ struct CompareOptions {
   std::string viewer = "vive";       // the eye's pixels per degree (trm/retina.hpp presets: vive, rift, monitor)
   std::optional<double> ppd;         // pixels per degree instead of the viewer preset's (finite, > 0)
   int substeps = 0;                  // retinal sub-frame steps S; 0: kDefaultRetinaSubsteps
+  std::optional<double> speed_deg_s; // the pursued target's speed (every motion of the scene scaled to it)
   // Throws std::invalid_argument with one clear message (an unknown method, one named twice, bad shared options).
   void validate() const;
   // The methods compared, in order: the asked ones, or every registered method.
@@ -69,6 +70,7 @@ struct CompareResult {
   double pixels_per_degree = 0.0;
   int scan_line = 0;                  // the row the eye model follows the target along
   double target_velocity_deg_s = 0.0; // horizontal speed of the pursued target
+  double motion_scale = 1.0;          // the scene's motions scaled by this (--speed)
   int substeps = 0;
   double continuous_blur_arcmin = 0.0;  // motion_blur_arcmin of the target moving continuously (its own edge)
   int window_begin = 0, window_width = 0;  // the scan line's columns the figures show and the blur is measured in

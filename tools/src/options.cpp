@@ -135,6 +135,7 @@ std::unique_ptr<FrameSource> PipelineOptions::open_source() const {
   params.refresh_hz = refresh_hz;
   params.seed = seed;
   params.image_path = image;
+  params.motion_scale = motion_scale;
   return make_scene(scene, params);
 }
 

@@ -25,6 +25,7 @@ struct PipelineOptions {
   int width = 1080, height = 1200;    // per-eye view size for analytic scenes
   double refresh_hz = 90.0;
   std::uint64_t seed = 1;
+  double motion_scale = 1.0;          // SceneParams::motion_scale (set by trm compare --speed)
   EncoderConfig encoder;
   double sensitivity = 10.0;
   Panel panel = parse_panel("vive");  // --panel, parsed once as it is read

@@ -18,6 +18,11 @@ struct SceneParams {
   std::uint64_t seed = 1;      // for scenes with randomness (jitter, procedural texture)
   std::string image_path;      // panorama / static: optional image to use instead of the procedural texture
   int supersample = 4;         // samples per axis per pixel for analytic anti-aliasing
+  // Every motion of the scene runs this many times as fast (scene time = frame time x motion_scale; velocities
+  // scale alike), so a comparison can set its target's speed. Finite and >= 0 (0: the scene frozen at its first
+  // frame); scenes whose motion is not a function of time (static, checker, flash, jitter's random head motion) accept
+  // only 1.
+  double motion_scale = 1.0;
 };
 
 // Motion of the content at one frame, in full-resolution pixels per second, for the eye model:

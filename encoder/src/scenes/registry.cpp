@@ -1,6 +1,7 @@
 #include "scenes/scene_support.hpp"
 #include "scenes/scenes.hpp"
 
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <utility>
@@ -12,11 +13,41 @@ AnalyticScene::AnalyticScene(std::string name, const SceneParams& params) : name
   scene_support::validate_params(params_, name_);
 }
 
-double AnalyticScene::seconds(std::int64_t t) const { return scene_support::frame_time(t, params_.refresh_hz); }
+double AnalyticScene::seconds(std::int64_t t) const {
+  return scene_support::frame_time(t, params_.refresh_hz) * params_.motion_scale;
+}
 
 }  // namespace scenes
 
 namespace {
+
+// Scenes time themselves by AnalyticScene::seconds, which applies motion_scale to where content is; this
+// applies it to the velocities they report, which are per second of scene time.
+class ScaledMotion final : public FrameSource {
+ public:
+  ScaledMotion(std::unique_ptr<FrameSource> scene, double scale) : scene_(std::move(scene)), scale_(scale) {}
+  std::string name() const override { return scene_->name(); }
+  int width() const override { return scene_->width(); }
+  int height() const override { return scene_->height(); }
+  std::optional<std::int64_t> frame_count() const override { return scene_->frame_count(); }
+  cv::Mat linear_frame(std::int64_t t) override { return scene_->linear_frame(t); }
+  Motion motion(std::int64_t t) const override {
+    Motion m = scene_->motion(t);
+    m.global_velocity_px_s *= scale_;
+    for (MotionObject& object : m.objects) object.velocity_px_s *= scale_;
+    return m;
+  }
+
+ private:
+  std::unique_ptr<FrameSource> scene_;
+  double scale_;
+};
+
+// The scenes whose motion is not a function of scene time.
+bool motion_is_timeless(const std::string& name) {
+  return name == "static" || name == "flash" || name == "checker" || name == "jitter";
+}
+
 using Factory = std::unique_ptr<FrameSource> (*)(const SceneParams&);
 const std::vector<std::pair<std::string, Factory>>& registry() {
   static const std::vector<std::pair<std::string, Factory>> table{
@@ -36,7 +67,17 @@ std::vector<std::string> scene_names() {
 
 std::unique_ptr<FrameSource> make_scene(const std::string& name, const SceneParams& params) {
   for (const auto& [scene_name, factory] : registry()) {
-    if (scene_name == name) return factory(params);
+    if (scene_name != name) continue;
+    if (params.motion_scale == 1.0) return factory(params);
+    if (!std::isfinite(params.motion_scale) || params.motion_scale < 0.0) {
+      throw std::invalid_argument("scene '" + name + "': the motion scale must be finite and >= 0, got " +
+                                  std::to_string(params.motion_scale));
+    }
+    if (motion_is_timeless(name)) {
+      throw std::invalid_argument("scene '" + name + "' has no motion whose speed can be set (its motion is not "
+                                  "a function of time)");
+    }
+    return std::make_unique<ScaledMotion>(factory(params), params.motion_scale);
   }
   std::string valid;
   for (const auto& entry : registry()) valid += (valid.empty() ? "" : ", ") + entry.first;
