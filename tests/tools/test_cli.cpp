@@ -505,6 +505,21 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   // one lights (4 of 8 frames against all 8).
   EXPECT_NEAR(blur["bfi"], blur["full"], 0.15 * blur["full"]);
   for (const auto& [name, width] : blur) EXPECT_GE(width, continuous_blur - 1e-9) << name;
+  // A still scene: TRM keeps the full light, and its artefact energy against full rate is of the order of the 8-bit
+  // link's own quantisation floor (full rate against the exact scene), not of the motion artefacts above.
+  const Result still = run_trm("compare --methods trm,full --scene static --size 216x120 --frames 8 --out " +
+                               tmp.str("still"));
+  ASSERT_EQ(still.exit_code, 0) << still.output;
+  std::ifstream in_still(tmp.str("still/report.json"));
+  const nlohmann::json still_report = nlohmann::json::parse(in_still);
+  std::map<std::string, nlohmann::json> still_by;
+  for (const auto& m : still_report["methods"]) still_by[m["method"].get<std::string>()] = m;
+  EXPECT_NEAR(still_by["trm"]["luminance_percent"].get<double>(), 100.0, 0.1);
+  EXPECT_LT(still_by["trm"]["energy_vs_full_rate"].get<double>(),
+            1.5 * still_by["full"]["energy_vs_continuous"].get<double>());
+  // Nothing moves: full rate has no temporal aliases; TRM's are its alternation of sharp and blurred frames.
+  EXPECT_LT(still_by["full"]["judder"].get<double>(), 1e-9);
+  EXPECT_GT(still_by["trm"]["judder"].get<double>(), 0.0);
   // A subset runs only what is asked (full rate still measured as the reference, not listed).
   const Result two = run_trm("compare --methods trm,bfi --scene panorama --size 64x48 --frames 4 --out " + tmp.str("two"));
   ASSERT_EQ(two.exit_code, 0) << two.output;
