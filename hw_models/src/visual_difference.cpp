@@ -178,15 +178,33 @@ double visual_difference_energy(const cv::Mat& l_a, const cv::Mat& l_b, double p
       kVisualDifferenceBeta);
 }
 
+namespace {
+
+// l minus each column's time average: what changes over time.
+cv::Mat changing_part(const cv::Mat& l) {
+  cv::Mat still;
+  cv::reduce(l, still, 0, cv::REDUCE_AVG, CV_64F);
+  return l - cv::repeat(still, l.rows, 1);
+}
+
+}  // namespace
+
 double temporal_alias_energy(const cv::Mat& l, double pixels_per_degree, double samples_per_second,
-                             double retinal_velocity_deg_s) {
+                             double retinal_velocity_deg_s, const cv::Mat& reference) {
   require_image("temporal_alias_energy", "l", l, Range::NonNegative);
+  if (!reference.empty()) {
+    require_image("temporal_alias_energy", "reference", reference, Range::NonNegative);
+    if (reference.size() != l.size()) {
+      reject("temporal_alias_energy", "reference", "must have the size of l (" + size_text(l) + " rows x cols), got " +
+                                                       size_text(reference));
+    }
+  }
   require_sampling("temporal_alias_energy", pixels_per_degree, samples_per_second, retinal_velocity_deg_s);
   const double adaptation = cv::mean(l)[0];
   if (adaptation <= 0.0) return 0.0;
-  cv::Mat still;
-  cv::reduce(l, still, 0, cv::REDUCE_AVG, CV_64F);
-  const cv::Mat contrast = (l - cv::repeat(still, l.rows, 1)) / adaptation;
+  cv::Mat change = changing_part(l);
+  if (!reference.empty()) change -= changing_part(reference);
+  const cv::Mat contrast = change / adaptation;
   return pooled_unchecked(weighted_unchecked(contrast, pixels_per_degree, samples_per_second, retinal_velocity_deg_s),
                           kVisualDifferenceBeta);
 }

@@ -143,6 +143,12 @@ TEST(TemporalAliasEnergy, StillImageHasNoneAndAHeldEdgeJuddersMoreThanAMovingOne
   EXPECT_GT(full, 0.0);
   EXPECT_GT(half, 2.0 * full);
   EXPECT_THROW((void)temporal_alias_energy(cv::Mat(), ppd, rate, 0.0), std::invalid_argument);
+  // Against a reference: its own aliases cancel, the extra ones remain.
+  const cv::Mat held = edge_xt(64, 64, +half_rate);
+  EXPECT_EQ(temporal_alias_energy(held, ppd, rate, 0.0, held), 0.0);
+  EXPECT_GT(temporal_alias_energy(held, ppd, rate, 0.0, edge_xt(64, 64, +full_rate)), 0.0);
+  EXPECT_THROW((void)temporal_alias_energy(held, ppd, rate, 0.0, cv::Mat(8, 8, CV_64FC1, cv::Scalar(0.0))),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -465,6 +465,8 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   EXPECT_EQ(by_method["half-rate"]["flicker_contrast"].get<double>(), 0.0);
   EXPECT_NEAR(by_method["bfi"]["flicker_contrast"].get<double>(), 1.0, 1e-12);
   EXPECT_EQ(by_method["full"]["energy_vs_full_rate"].get<double>(), 0.0);
+  EXPECT_EQ(by_method["full"]["judder_vs_full_rate"].get<double>(), 0.0);
+
   EXPECT_GT(by_method["full"]["mean_pair_ssim"].get<double>(), by_method["bfi"]["mean_pair_ssim"].get<double>());
   EXPECT_LE(by_method["full"]["mean_pair_ssim"].get<double>(), 1.0);
   EXPECT_GT(by_method["trm"]["energy_vs_full_rate"].get<double>(), 0.0);
@@ -497,7 +499,17 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   std::ifstream in_discs(tmp.str("discs/report.json"));
   const nlohmann::json disc_report = nlohmann::json::parse(in_discs);
   std::map<std::string, double> blur;
-  for (const auto& m : disc_report["methods"]) blur[m["method"].get<std::string>()] = m["motion_blur_arcmin"].get<double>();
+  std::map<std::string, double> judder, extra_judder;
+  for (const auto& m : disc_report["methods"]) {
+    blur[m["method"].get<std::string>()] = m["motion_blur_arcmin"].get<double>();
+    judder[m["method"].get<std::string>()] = m["judder"].get<double>();
+    extra_judder[m["method"].get<std::string>()] = m["judder_vs_full_rate"].get<double>();
+  }
+  // The repeat shows the disc in one place for two frames while the eye moves on: judder beyond full rate's (the
+  // absolute figure of every method also holds the sub-pixel phase of each frame's disc, full rate's included).
+  EXPECT_GT(extra_judder["half-rate"], 0.0);
+  for (const auto& [name, value] : judder) EXPECT_GT(value, 0.0) << name;
+  EXPECT_EQ(extra_judder["full"], 0.0);
   const double continuous_blur = disc_report["eye"]["continuous_blur_arcmin"].get<double>();
   EXPECT_NEAR(std::abs(disc_report["eye"]["target_velocity_deg_s"].get<double>()), 20.0, 1e-9);
   EXPECT_GT(blur["half-rate"], 1.5 * blur["full"]);

@@ -60,6 +60,9 @@ struct MethodMeasure {
   // Judder: temporal_alias_energy (visual_difference.hpp) of the target-frame x-t image sampled once per frame
   // (each frame's light integrated): where successive frames put the pursued target.
   double judder = 0.0;
+  // The aliases beyond full rate's (temporal_alias_energy with the `full` method's image as the reference): the
+  // pixel grid sweeping the retina, which every method shares, cancels.
+  double judder_vs_full_rate = 0.0;
   std::int64_t pairs = 0;
   double seconds = 0.0;                         // wall time of this method's run
 };

@@ -70,8 +70,10 @@ double visual_difference_energy(const cv::Mat& l_a, const cv::Mat& l_b, double p
 // (Weber contrast at the region's adaptation level), C = (l − l̄) / L̄, rather than Eq. 1's (l − l̄) / (l + l̄): Eq. 1
 // divides by the local luminance, which on a dark background turns the sub-pixel phase differences in an edge's
 // dark tail into contrasts near 1. 0 for a still or a black image. Uniform flicker (ρ = 0) adds nothing, as in
-// Eq. 2. Same arguments and errors as visual_difference_energy.
+// Eq. 2. With a `reference` (same size), the aliases l has beyond the reference's: the changing part of the
+// reference is subtracted from l's before weighting (a display's own aliases, such as a pixel grid moving over the
+// retina, cancel; 0 when l and the reference are equal). Same arguments and errors as visual_difference_energy.
 double temporal_alias_energy(const cv::Mat& l, double pixels_per_degree, double samples_per_second,
-                             double retinal_velocity_deg_s);
+                             double retinal_velocity_deg_s, const cv::Mat& reference = {});
 
 }  // namespace trm
