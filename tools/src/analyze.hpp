@@ -75,7 +75,7 @@ struct CyclePoint {
   double pixels_saved_percent = 0.0;  // k / (k + 1) (1 - r^2) 100
   double cycle_hz = 0.0;              // refresh / (k + 1): the fundamental of the alternation
   double energy = 0.0;                // the cycle model against full rate
-  double clipped_percent = 0.0;       // light the compensation could not show, % of the full frames' light
+  double clipped_percent = 0.0;       // |rho| of the full frames: boost outside [0, 1], % of the full frames' light
   double pipeline_energy = 0.0;       // k = 1: the real encoder and decoder's energy at this point (else NaN)
 };
 
