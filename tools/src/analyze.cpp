@@ -689,6 +689,7 @@ AnalyzeResult run_analyze(const AnalyzeOptions& options,
   for (int k : options.cycles) cycle_length = std::lcm(cycle_length, static_cast<std::int64_t>(k + 1));
   AnalyzeOptions whole_cycles = options;
   whole_cycles.pipeline.frames = (options.frames() + cycle_length - 1) / cycle_length * cycle_length;
+  result.cycle_frames = whole_cycles.pipeline.frames;
   for (double speed : options.speeds) {
     const Stimulus stimulus = square_stimulus(whole_cycles, options.ppd, speed, options.contrast,
                                               options.pipeline.refresh_hz, reach);
@@ -842,7 +843,8 @@ std::string analyze_markdown(const AnalyzeResult& result) {
     out << "\n";
   }
   out << "\n## §1.4: 1 full + k reduced frames (" << text_of(o.ppd) << " ppd, " << text_of(o.pipeline.refresh_hz)
-      << " Hz, contrast " << text_of(o.contrast) << ")\n\n| k | speed | r | pixels saved % | cycle Hz | energy | clipped % | "
+      << " Hz, contrast " << text_of(o.contrast) << ", " << result.cycle_frames
+      << " frames)\n\n| k | speed | r | pixels saved % | cycle Hz | energy | clipped % | "
          "real pipeline energy |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const CyclePoint& p : result.cycles) {
     out << "| " << p.reduced_frames << " | " << text_of(p.speed_deg_s) << " | " << text_of(p.reduction) << " | "
@@ -946,8 +948,8 @@ std::vector<std::string> write_analyze_plots(const std::string& directory, const
   {
     plot::Figure figure;
     figure.title = "1 full + k reduced frames (supplement §1.4)";
-    figure.subtitle = settings_line(result) + "; " + text_of(o.ppd) + " ppd, " + text_of(o.pipeline.refresh_hz) +
-                      " Hz, contrast " + text_of(o.contrast);
+    figure.subtitle = settings_line(result) + " (here " + std::to_string(result.cycle_frames) + ", whole cycles); " +
+                      text_of(o.ppd) + " ppd, " + text_of(o.pipeline.refresh_hz) + " Hz, contrast " + text_of(o.contrast);
     for (double speed : o.speeds) {
       plot::Chart chart;
       chart.title = text_of(speed) + " deg/s";

@@ -92,6 +92,7 @@ struct AnalyzeResult {
   double threshold_energy = 0.0;
   std::vector<Exp1Point> exp1;
   std::vector<CyclePoint> cycles;
+  std::int64_t cycle_frames = 0;  // frames of the cycle runs: whole cycles of every k
   std::vector<TrendCheck> trends;
   double seconds = 0.0;
 };
