@@ -27,7 +27,7 @@ bool in_unit_range(const cv::Mat& m) { return cv::checkRange(m, true, nullptr, 0
 double max_diff(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
 
 TEST(Scenes, AllNamesAreRegistered) {
-  const std::vector<std::string> expected{"discs", "text", "panorama", "line", "zoneplate", "checker", "flash", "static", "jitter"};
+  const std::vector<std::string> expected{"discs", "text", "panorama", "line", "zoneplate", "checker", "flash", "static", "jitter", "square"};
   EXPECT_EQ(scene_names(), expected);
 }
 
@@ -271,6 +271,44 @@ TEST(StaticScene, ShowsTheGivenImageInLinearLight) {
   p.image_path = (dir / "missing.png").string();
   EXPECT_THROW(make_scene("static", p), std::runtime_error);
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace trm
+
+namespace trm {
+namespace {
+
+// The supplement's square: luminances 0.5 (1 ± c) and an exact box filter, so the light above the background sums to
+// side^2 c at any sub-pixel position, and the square's left edge moves by speed / refresh per frame.
+TEST(Scenes, MovingSquareIsExactAtSubPixelPositions) {
+  SceneParams p = small_params(64, 40, 90.0);
+  MovingSquare square;
+  square.side_px = 10.5;
+  square.speed_px_s = 90.0 * 1.25;  // 1.25 pixels per frame
+  square.start_left_px = 7.3;
+  square.contrast = 0.2;
+  auto scene = make_moving_square(p, square);
+  for (std::int64_t t : {0, 1, 5}) {
+    const cv::Mat f = scene->linear_frame(t);
+    cv::Mat grey;
+    cv::extractChannel(f, grey, 0);
+    const double dark = 0.5 * (1.0 - 0.2);
+    EXPECT_NEAR(cv::sum(grey - dark)[0], 10.5 * 10.5 * 0.2, 1e-9) << t;
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(grey, &lo, &hi);
+    EXPECT_NEAR(lo, dark, 1e-12);
+    EXPECT_NEAR(hi, 0.5 * 1.2, 1e-12);
+    const Motion m = scene->motion(t);
+    ASSERT_EQ(m.objects.size(), 1u);
+    EXPECT_NEAR(m.objects[0].bounds.x, 7.3 + 1.25 * static_cast<double>(t), 1e-9);
+    EXPECT_DOUBLE_EQ(m.objects[0].velocity_px_s[0], 112.5);
+  }
+  square.contrast = 1.5;
+  EXPECT_THROW(make_moving_square(p, square), std::invalid_argument);
+  square.contrast = 0.2;
+  square.side_px = 0.0;
+  EXPECT_THROW(make_moving_square(p, square), std::invalid_argument);
 }
 
 }  // namespace

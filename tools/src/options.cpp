@@ -140,7 +140,7 @@ std::unique_ptr<FrameSource> PipelineOptions::open_source() const {
 }
 
 void PipelineOptions::add_options(CLI::App& cmd) {
-  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter)")
+  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter, square)")
       ->capture_default_str();
   cmd.add_option("--input", input, "Image sequence glob ('DIR/frame_*.png', sorted by name, sRGB) or a video file");
   cmd.add_option("--image", image, "Image for the panorama and static scenes (default: procedural texture)");

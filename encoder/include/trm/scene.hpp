@@ -50,10 +50,25 @@ class FrameSource {
   virtual Motion motion(std::int64_t t) const = 0;
 };
 
-// Names: discs, text, panorama, line, zoneplate, checker, flash, static, jitter.
+// Names: discs, text, panorama, line, zoneplate, checker, flash, static, jitter, square.
 std::vector<std::string> scene_names();
 // Throws std::invalid_argument naming the valid scenes when name is unknown.
 std::unique_ptr<FrameSource> make_scene(const std::string& name, const SceneParams& params);
+
+// The supplement's stimulus (§1.1): a square moving horizontally at a constant speed over a uniform background,
+// the two linear luminances equidistant from half the display's, 0.5 (1 + c) and 0.5 (1 - c) for Michelson contrast
+// c, so that neither the compensated frame's overshoot nor its undershoot reaches the display's range first. The
+// square is vertically centred and wraps around horizontally (period: view width + side). Every pixel is the exact
+// box-filter average of the continuous scene. "square" in make_scene is this with the defaults below.
+struct MovingSquare {
+  std::optional<double> side_px;        // default: a quarter of the smaller view side
+  std::optional<double> speed_px_s;     // default: half a view width per second (negative: toward -x)
+  std::optional<double> start_left_px;  // the left edge at t = 0; default: the square centred in the view
+  double contrast = 0.2;                // Michelson contrast, in [0, 1]; the square is the brighter
+};
+// Throws std::invalid_argument naming the field for a side that is not finite and > 0, a speed or start that is not
+// finite, or a contrast outside [0, 1]; and as make_scene for bad params.
+std::unique_ptr<FrameSource> make_moving_square(const SceneParams& params, const MovingSquare& square);
 
 // Image sequence: a glob such as 'DIR/frame_*.png' (sorted by name), 8- or 16-bit PNG (or any format
 // OpenCV reads), sRGB-encoded. Validates up front: at least one file, all readable images, same size.

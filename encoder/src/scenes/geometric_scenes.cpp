@@ -1,4 +1,4 @@
-// Scenes drawn from closed-form geometry: discs, line, zoneplate, checker, flash.
+// Scenes drawn from closed-form geometry: discs, line, zoneplate, checker, flash, square.
 // Every pixel value is the box-filter average (over the pixel square) of the continuous linear-light
 // scene: exactly where the integral is closed-form, by supersampling where it is not.
 #include "scenes/scene_support.hpp"
@@ -8,6 +8,8 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <vector>
 
 namespace trm::scenes {
 namespace {
@@ -230,8 +232,75 @@ class FlashScene final : public AnalyticScene {
   Motion motion(std::int64_t) const override { return {}; }
 };
 
+// --- square (supplement §1.1): a square of one luminance sliding over a background of another ---------
+class SquareScene final : public AnalyticScene {
+ public:
+  SquareScene(const SceneParams& p, const MovingSquare& square) : AnalyticScene("square", p) {
+    side_ = square.side_px.value_or(std::max(1.0, 0.25 * std::min(p.width, p.height)));
+    speed_ = square.speed_px_s.value_or(0.5 * p.width);
+    start_ = square.start_left_px.value_or(0.5 * (p.width - side_));
+    if (!(std::isfinite(side_) && side_ > 0.0)) throw std::invalid_argument("scene 'square': the side must be a finite number of pixels > 0");
+    if (!std::isfinite(speed_)) throw std::invalid_argument("scene 'square': the speed must be a finite number of pixels per second");
+    if (!std::isfinite(start_)) throw std::invalid_argument("scene 'square': the start position must be finite");
+    if (!(square.contrast >= 0.0 && square.contrast <= 1.0)) {
+      throw std::invalid_argument("scene 'square': the Michelson contrast must be in [0, 1]");
+    }
+    bright_ = 0.5 * (1.0 + square.contrast);
+    dark_ = 0.5 * (1.0 - square.contrast);
+    period_ = p.width + side_;
+  }
+
+  // Coverage is separable: the fraction of a pixel's column interval the square covers times that of its row
+  // interval, so the box filter is exact.
+  cv::Mat linear_frame(std::int64_t t) override {
+    std::vector<double> across(static_cast<std::size_t>(width()), 0.0);
+    for (double left : copies(t)) {
+      for (int x = std::max(0, static_cast<int>(std::floor(left)));
+           x < std::min(width(), static_cast<int>(std::ceil(left + side_))); ++x) {
+        across[static_cast<std::size_t>(x)] += overlap(x, left, left + side_);
+      }
+    }
+    const double top = 0.5 * (height() - side_);
+    cv::Mat frame(height(), width(), CV_64FC3);
+    for (int y = 0; y < height(); ++y) {
+      const double down = overlap(y, top, top + side_);
+      cv::Vec3d* row = frame.ptr<cv::Vec3d>(y);
+      for (int x = 0; x < width(); ++x) {
+        const double coverage = std::min(1.0, across[static_cast<std::size_t>(x)]) * down;
+        row[x] = cv::Vec3d::all(dark_ + (bright_ - dark_) * coverage);
+      }
+    }
+    return frame;
+  }
+
+  Motion motion(std::int64_t t) const override {
+    Motion m;
+    for (double left : copies(t)) {
+      m.objects.push_back({cv::Rect2d(left, 0.5 * (height() - side_), side_, side_), cv::Vec2d(speed_, 0.0)});
+    }
+    return m;
+  }
+
+ private:
+  static double overlap(int pixel, double begin, double end) {
+    return std::max(0.0, std::min<double>(pixel + 1, end) - std::max<double>(pixel, begin));
+  }
+  // The square's left edge at t and the wrapped copies that overlap the view.
+  std::vector<double> copies(std::int64_t t) const {
+    const double left = wrap(start_ + side_ + speed_ * seconds(t), period_) - side_;
+    std::vector<double> out;
+    for (double c : {left - period_, left, left + period_}) {
+      if (c + side_ > 0.0 && c < width()) out.push_back(c);
+    }
+    return out;
+  }
+
+  double side_ = 0, speed_ = 0, start_ = 0, bright_ = 0, dark_ = 0, period_ = 0;
+};
+
 }  // namespace
 
+std::unique_ptr<FrameSource> make_square(const SceneParams& p) { return std::make_unique<SquareScene>(p, MovingSquare{}); }
 std::unique_ptr<FrameSource> make_discs(const SceneParams& p) { return std::make_unique<DiscsScene>(p); }
 std::unique_ptr<FrameSource> make_line(const SceneParams& p) { return std::make_unique<LineScene>(p); }
 std::unique_ptr<FrameSource> make_zoneplate(const SceneParams& p) { return std::make_unique<ZoneplateScene>(p); }
@@ -239,3 +308,9 @@ std::unique_ptr<FrameSource> make_checker(const SceneParams& p) { return std::ma
 std::unique_ptr<FrameSource> make_flash(const SceneParams& p) { return std::make_unique<FlashScene>(p); }
 
 }  // namespace trm::scenes
+
+namespace trm {
+std::unique_ptr<FrameSource> make_moving_square(const SceneParams& params, const MovingSquare& square) {
+  return std::make_unique<scenes::SquareScene>(params, square);
+}
+}  // namespace trm

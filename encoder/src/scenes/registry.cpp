@@ -54,6 +54,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"discs", scenes::make_discs},         {"text", scenes::make_text},       {"panorama", scenes::make_panorama},
       {"line", scenes::make_line},           {"zoneplate", scenes::make_zoneplate}, {"checker", scenes::make_checker},
       {"flash", scenes::make_flash},         {"static", scenes::make_static},   {"jitter", scenes::make_jitter},
+      {"square", scenes::make_square},
   };
   return table;
 }
