@@ -139,3 +139,16 @@ def test_configuration_patches_keep_defaults():
     assert config["decoder"]["encoder"]["sigma"] == pytest.approx(1.25 / 0.25)  # the default sigma follows r
     assert config["formats"] == defaults["formats"]
     assert trm.__version__.count(".") == 2
+
+
+def test_decoders_run_in_threads(views):
+    # The GIL is released while decoding: two decoders in two threads give what they give one after the other.
+    from concurrent.futures import ThreadPoolExecutor
+    serial = [trm.Decoder("fixed").decode_all(views)[-1].drive_codes for _ in range(2)]
+    with ThreadPoolExecutor(2) as pool:
+        threaded = list(pool.map(lambda _: trm.Decoder("fixed").decode_all(views)[-1].drive_codes, range(2)))
+    for a, b in zip(serial, threaded):
+        np.testing.assert_array_equal(a, b)
+    shared = trm.Decoder("fixed")  # one decoder shared by threads: serialised, never torn
+    with ThreadPoolExecutor(2) as pool:
+        list(pool.map(lambda v: shared.decode(v), views))

@@ -20,7 +20,9 @@
 #include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <stdexcept>
@@ -197,6 +199,8 @@ View make_view(const py::handle& codes, std::int64_t t, const std::string& parit
   return view;
 }
 
+// The GIL is released while a decoder runs (other Python threads, other decoders, go on); the lock keeps two threads
+// from running one decoder, whose per-eye state is not for concurrent use, at once.
 class Decoder {
  public:
   Decoder(const std::string& name, const py::object& config)
@@ -208,7 +212,11 @@ class Decoder {
   Decoded decode(const View& view, const py::object& line_intact) {
     if (line_intact.is_none()) {
       py::gil_scoped_release unlocked;
-      return Decoded{decoder_->decode(view.frame)};
+      const std::lock_guard<std::mutex> lock(mutex_);
+      const auto start = std::chrono::steady_clock::now();
+      Decoded out{decoder_->decode(view.frame)};
+      last_decode_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return out;
     }
     if (!py::isinstance<py::array>(line_intact) ||
         !py::reinterpret_borrow<py::array>(line_intact).dtype().is(py::dtype::of<std::uint8_t>()) ||
@@ -219,11 +227,13 @@ class Decoder {
     const auto mask = py::array_t<std::uint8_t, py::array::c_style>::ensure(line_intact);
     const std::span<const std::uint8_t> lines(mask.data(), static_cast<std::size_t>(mask.size()));
     py::gil_scoped_release unlocked;
+    const std::lock_guard<std::mutex> lock(mutex_);
     return Decoded{decoder_->decode(view.frame, lines)};
   }
 
   Decoded decode_lost(const View& view) {
     py::gil_scoped_release unlocked;
+    const std::lock_guard<std::mutex> lock(mutex_);
     return Decoded{decoder_->decode_lost(view.frame.meta)};
   }
 
@@ -232,11 +242,20 @@ class Decoder {
     std::vector<Decoded> out;
     out.reserve(views.size());
     py::gil_scoped_release unlocked;
+    const std::lock_guard<std::mutex> lock(mutex_);
     for (const View* view : views) out.push_back(Decoded{decoder_->decode(view->frame)});
     return out;
   }
 
+  // The time the C++ decoder took in the last decode() of a whole view: a Python caller's time minus this is what
+  // the call through the module cost (tools/python/bench_bindings.py).
+  double last_decode_seconds() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return last_decode_seconds_;
+  }
+
   py::object stage_counts() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
     const FixedStageCounts* counts = decoder_->stage_counts();
     if (counts == nullptr) return py::none();
     return counts_of(*counts);
@@ -245,6 +264,8 @@ class Decoder {
  private:
   FixedDecoderConfig config_;
   std::unique_ptr<HeadsetDecoder> decoder_;
+  double last_decode_seconds_ = 0.0;
+  mutable std::mutex mutex_;
 };
 
 Panel panel_of(const py::object& spec) {
@@ -332,12 +353,7 @@ PYBIND11_MODULE(trm, m) {
                throw std::invalid_argument("frame: t = " + std::to_string(t) + " but the input has " +
                                            std::to_string(*n) + " frames");
              }
-             cv::Mat frame;
-             {
-               py::gil_scoped_release unlocked;
-               frame = s.linear_frame(t);
-             }
-             return share_image(frame);
+             return share_image(s.linear_frame(t));  // with the GIL held: a source is not for concurrent use
            }, py::arg("t"), "Frame t: HxWx3 float64 linear RGB in [0, 1] (read-only, no copy).");
   m.def("scene", [](const std::string& name, int width, int height, double refresh_hz, std::uint64_t seed,
                     const std::string& image, int supersample) {
@@ -424,6 +440,8 @@ PYBIND11_MODULE(trm, m) {
       .def("decode_lost", &Decoder::decode_lost, py::arg("view"),
            "The view never arrived: the panel holds this eye's previous output (black if none).")
       .def("decode_all", &Decoder::decode_all, py::arg("views"), "decode() of every view, in one call.")
+      .def_property_readonly("last_decode_seconds", &Decoder::last_decode_seconds,
+                             "Seconds the C++ decoder spent in the last decode(view) without a line mask.")
       .def_property_readonly("stage_counts", &Decoder::stage_counts,
                              "Fixed-point stage events of the last view as a dict; None for the reference.");
 
