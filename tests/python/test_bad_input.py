@@ -50,6 +50,8 @@ def test_unknown_names(view):
         trm.scene("no-such-scene")
     with pytest.raises(ValueError, match="parity must be 'full' or 'reduced'"):
         trm.Encoder().encode(trm.scene("discs", width=8, height=8).frame(0), 0, parity="half")
+    with pytest.raises(ValueError, match="parity must be None, 'full' or 'reduced'"):
+        trm.Encoder().encode(trm.scene("discs", width=8, height=8).frame(0), 0, parity=3)
     with pytest.raises(ValueError, match="panel"):
         trm.Panel("plasma")
 
@@ -64,7 +66,9 @@ def test_unknown_names(view):
     ({"decoder": {}, "formats": {"no_such_format": 3}}, "unknown field 'no_such_format'"),
     ({"panel": "gamma:9"}, "gamma"),
     ({"panel": {"kind": "oled"}}, "panel"),
-    ({"sensitivity": float("nan")}, "not representable as JSON|sensitivity"),
+    ({"sensitivity": float("nan")}, "not representable as JSON"),
+    ({"sensitivity": float("inf")}, "infinite sensitivity is the string"),
+    ({"decoder": 5}, "expected an object"),
 ])
 def test_invalid_configuration(config, message):
     with pytest.raises(ValueError, match=message):

@@ -42,10 +42,12 @@ using Json = nlohmann::json;
 
 Json json_of(const py::handle& value, const std::string& what) {
   try {
-    const std::string text = py::module_::import("json").attr("dumps")(value).cast<std::string>();
+    const std::string text =
+        py::module_::import("json").attr("dumps")(value, py::arg("allow_nan") = false).cast<std::string>();
     return Json::parse(text);
   } catch (const py::error_already_set& e) {
-    throw std::invalid_argument(what + ": not representable as JSON (" + std::string(e.what()) + ")");
+    throw std::invalid_argument(what + ": not representable as JSON (" + std::string(e.what()) +
+                                "; an infinite sensitivity is the string \"inf\")");
   }
 }
 
@@ -405,6 +407,9 @@ PYBIND11_MODULE(trm, m) {
                         const py::object& parity) {
              py::object keep;
              const cv::Mat frame = borrow_image(linear, Element::Float64, 3, "encode: linear", keep);
+             if (!parity.is_none() && !py::isinstance<py::str>(parity)) {
+               throw std::invalid_argument("encode: parity must be None, 'full' or 'reduced'");
+             }
              const std::optional<Parity> forced =
                  parity.is_none() ? std::nullopt : std::optional(parity_of_name(parity.cast<std::string>()));
              py::gil_scoped_release unlocked;
