@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def trm_binary():
     path = os.environ.get("TRM_BINARY")
     if not path or not pathlib.Path(path).is_file():
