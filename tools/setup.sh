@@ -24,6 +24,8 @@ packages=(
   fonts-dejavu-core        # the plots' text on a machine with no desktop fonts
   umockdev libumockdev-dev # emulated USB/HID devices for rig tests
   clang libclang-rt-14-dev # libFuzzer for the link receiver
+  python3-dev pybind11-dev python3-pybind11  # the Python module `trm` (tools/python), built for /usr/bin/python3
+  python3-numpy python3-pytest               # its arrays and its test suite (tests/python)
 )
 
 missing=()
