@@ -14,7 +14,7 @@ packages=(
   libhidapi-dev            # HID rig feeder (hidraw + libusb backends)
   libgtest-dev libgmock-dev
   libbenchmark-dev         # Google Benchmark
-  libsystemc-dev           # sc_fixed: independent oracle for the fixed-point type
+  libsystemc-dev           # sc_fixed: independent oracle for the fixed-point type; the decoder as a SystemC module
   libcli11-dev             # command-line parsing
   nlohmann-json3-dev       # report.json
   zlib1g-dev               # CRC32 for link packets
@@ -24,6 +24,7 @@ packages=(
   fonts-dejavu-core        # the plots' text on a machine with no desktop fonts
   umockdev libumockdev-dev # emulated USB/HID devices for rig tests
   clang libclang-rt-14-dev # libFuzzer for the link receiver
+  verilator                # the decoder as a DPI-C golden model in an HDL simulation (tests/hdl)
 )
 
 missing=()
