@@ -70,7 +70,7 @@ module trm_decoder_model #(
     string config_path;
     if (!$value$plusargs({CONFIG_PLUSARG, "=%s"}, config_path))
       $fatal(1, "trm_decoder_model: +%s=PATH (the decoder's JSON configuration) is required", CONFIG_PLUSARG);
-    decoder = trm_dpi_create(config_path);
+    else decoder = trm_dpi_create(config_path);
     if (decoder == null) $fatal(1, "trm_decoder_model: %s", trm_dpi_last_error(null));
   end
 

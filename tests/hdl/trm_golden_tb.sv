@@ -74,7 +74,10 @@ module trm_golden_tb;
     string text, s, p, name;
     longint unsigned hash;
     fd = $fopen(path, "r");
-    if (fd == 0) $fatal(1, "cannot open the golden hashes '%s'", path);
+    if (fd == 0) begin
+      $fatal(1, "cannot open the golden hashes '%s'", path);
+      return;
+    end
     while ($fgets(text, fd) != 0) begin
       if (text.len() == 0 || text.getc(0) == "#") continue;
       if ($sscanf(text, "%s %s %s %h", s, p, name, hash) != 4) $fatal(1, "%s: malformed line '%s'", path, text);
@@ -94,7 +97,10 @@ module trm_golden_tb;
     fd = $fopen(path, "r");
     lines = 0;
     samples = -1;
-    if (fd == 0) $fatal(1, "cannot open the vector file '%s' (run `trm vectors` for %s %s)", path, scene, panel);
+    if (fd == 0) begin
+      $fatal(1, "cannot open the vector file '%s' (run `trm vectors` for %s %s)", path, scene, panel);
+      return;
+    end
     if (golden.exists(name) == 0) $fatal(1, "%s has no golden hash for %s %s", name, scene, panel);
     while ($fgets(text, fd) != 0) begin
       int words = 0, value = 0, digits = 0;
@@ -132,11 +138,15 @@ module trm_golden_tb;
              golden[name]);
   endtask
 
-  initial begin
+  // Reads the golden hashes and every vector file of the scene; stops at the first problem, with its reason.
+  task automatic load_vectors();
     string golden_path;
     if (!$value$plusargs("vectors=%s", vectors_dir) || !$value$plusargs("golden=%s", golden_path) ||
         !$value$plusargs("scene=%s", scene) || !$value$plusargs("panel=%s", panel))
+    begin
       $fatal(1, "usage: +vectors=DIR +golden=FILE +scene=NAME +panel=NAME +trm_config=FILE");
+      return;
+    end
     read_golden(golden_path);
     frames = 0;
     for (int t = 0; t < MAX_FRAMES; t++) begin
@@ -145,7 +155,10 @@ module trm_golden_tb;
       frame_reduced[t] = golden.exists(full) == 0;
       frames++;
     end
-    if (frames == 0) $fatal(1, "%s lists no drive file for %s %s", golden_path, scene, panel);
+    if (frames == 0) begin
+      $fatal(1, "%s lists no drive file for %s %s", golden_path, scene, panel);
+      return;
+    end
     for (int t = 0; t < frames; t++) begin
       string kind = parity_name(frame_reduced[t]);
       read_vector_file($sformatf("frame_%03d_%s_codes.hex", t, kind), 3'(t), 1'b0, code_lines[t], code_samples[t]);
@@ -153,7 +166,9 @@ module trm_golden_tb;
     end
     $display("trm_golden_tb: %s %s, %0d frames of %0dx%0d, vector files match their golden hashes", scene, panel,
              frames, drive_samples[0] / 3, drive_lines[0]);
-  end
+  endtask
+
+  initial load_vectors();
 
   // ---- the line stream, the same for the model and the DUT (a valid each, the data shared) -----------------------
   logic        model_in_valid, dut_in_valid, in_first, in_kind, in_eye, in_intact;
