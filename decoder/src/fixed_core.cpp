@@ -13,7 +13,10 @@ FixedDecoderCore::FixedDecoderCore(FixedDecoderConfig config) : kernels_(config)
 
 EyeState& FixedDecoderCore::begin(const LinkFrame& frame, const char* who) {
   detail::check_link_frame(frame, kernels_.config().decoder.link, who);
-  const FrameMeta& meta = frame.meta;
+  return begin(frame.meta);
+}
+
+EyeState& FixedDecoderCore::begin(const FrameMeta& meta) {
   const cv::Size full(meta.full_width, meta.full_height);
   EyeState& eye = eyes_[meta.eye];
   if (eye.full_size != full) {
@@ -39,10 +42,10 @@ cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type) {
   return plane;
 }
 
-FrameOutput FixedDecoderCore::start_output(const LinkFrame& frame, EyeState& eye) const {
+FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye) const {
   FrameOutput out;
-  const cv::Size full(frame.meta.full_width, frame.meta.full_height);
-  out.frame.meta = frame.meta;
+  const cv::Size full(meta.full_width, meta.full_height);
+  out.frame.meta = meta;
   out.frame.meta.width = full.width;
   out.frame.meta.height = full.height;
   for (const DecodedFrame& spare : eye.spare_outputs) {

@@ -73,6 +73,10 @@ class FixedDecoderCore {
 
   // Checks the frame and returns the eye state (reset on a change of view size).
   EyeState& begin(const LinkFrame& frame, const char* who);
+  // The same for a view already checked (detail::check_view_header) that arrives line by line.
+  EyeState& begin(const FrameMeta& meta);
+  // The d_{t-1} a partial view's lost lines would repeat (detail::concealment_substitute), before begin.
+  cv::Mat concealment_substitute(const FrameMeta& meta) const { return detail::concealment_substitute(eyes_, meta); }
   // Classifies a line mask (detail::classify_arrival) and, for a partial view, takes the substitute d_{t-1} from
   // this decoder's eyes (detail::concealment_substitute).
   detail::Arrival classify(const LinkFrame& frame, std::span<const std::uint8_t> line_intact,
@@ -80,7 +84,7 @@ class FixedDecoderCore {
   // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
   DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
   // The output matrices at full size: planes of an earlier view of the eye that no caller holds any more, else new.
-  FrameOutput start_output(const LinkFrame& frame, EyeState& eye) const;
+  FrameOutput start_output(const FrameMeta& meta, EyeState& eye) const;
   // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
   Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
   // Prepares the LCD frame stores of the eye for this frame (first frame: held history).

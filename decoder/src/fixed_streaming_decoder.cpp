@@ -9,10 +9,15 @@
 //      is produced if all its vertical taps have arrived (it enters the 2-line U buffer and the d_t frame store).
 // Reduced frame, after each input line i(k): it enters the 2-line U buffer and every output row with i1 <= k is
 // produced. The residual and d_{t-1} frame stores are read row by row.
+//
+// A view is decoded incrementally (StreamingView: begin, one push per input line, end), as the hardware receives it;
+// decode() pushes a whole frame's lines through the same steps.
 #include "fixed_core.hpp"
 #include "line_ring.hpp"
 
 #include <algorithm>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,16 +31,18 @@ using fixed_detail::Raw;
 
 namespace {
 
-// The full-frame schedule as callbacks: on_input(y_in), on_reduced(k, y_in), on_output(y, y_in, reduced_ready).
-// Nothing is produced before input line `first` (concealment: lost lines above the first intact line take that
-// line's content, so work that needs them waits for it; 0 normally).
-template <typename OnInput, typename OnReduced, typename OnOutput>
-void full_frame_schedule(const Geometry& g, OnInput on_input, OnReduced on_reduced, OnOutput on_output, int first = 0) {
+constexpr const char* kWho = "FixedStreamingDecoder";
+
+// The full-frame schedule, stepped once per input line: after input line y_in, on_reduced(k, y_in) for every reduced
+// row of d_t whose vertical taps have all arrived and on_output(y, y_in, reduced_ready) for every output row whose U
+// rows exist. Nothing is stepped before input line `first` of a view (concealment: lost lines above the first intact
+// line take that line's content, so work that needs them waits for it; 0 normally).
+struct FullSchedule {
   int next_reduced = 0;
   int next_output = 0;
-  for (int y_in = 0; y_in < g.full.height; ++y_in) {
-    on_input(y_in);
-    if (y_in < first) continue;
+
+  template <typename OnReduced, typename OnOutput>
+  void after_input(const Geometry& g, int y_in, OnReduced&& on_reduced, OnOutput&& on_output) {
     for (;;) {
       while (next_output < g.full.height && next_output <= y_in &&
              g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 < next_reduced) {
@@ -48,20 +55,19 @@ void full_frame_schedule(const Geometry& g, OnInput on_input, OnReduced on_reduc
       }
     }
   }
-}
+};
 
-// The reduced-frame schedule: on_input(k), on_output(y, k); nothing is produced before input line `first`.
-template <typename OnInput, typename OnOutput>
-void reduced_frame_schedule(const Geometry& g, OnInput on_input, OnOutput on_output, int first = 0) {
+// The reduced-frame schedule: after input line k, on_output(y, k) for every output row whose U rows i0, i1 <= k.
+struct ReducedSchedule {
   int next_output = 0;
-  for (int k = 0; k < g.reduced.height; ++k) {
-    on_input(k);
-    if (k < first) continue;
+
+  template <typename OnOutput>
+  void after_input(const Geometry& g, int k, OnOutput&& on_output) {
     while (next_output < g.full.height && g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 <= k) {
       on_output(next_output++, k);
     }
   }
-}
+};
 
 // Line counts the schedules need, from a dry run over the indices.
 struct StreamPlan {
@@ -75,27 +81,272 @@ struct StreamPlan {
 
 StreamPlan plan_for(const Geometry& g) {
   StreamPlan p;
-  full_frame_schedule(
-      g, [](int) {},
-      [&](int k, int y_in) {
-        p.gauss_lines = std::max(p.gauss_lines, y_in - g.gauss_rows[static_cast<std::size_t>(k)].first() + 1);
-      },
-      [&](int y, int y_in, int ready) {
-        p.delay_lines = std::max(p.delay_lines, y_in - y + 1);
-        p.full_latency = std::max(p.full_latency, y_in - y);
-        p.low_lines = std::max(p.low_lines, ready - g.bilinear_rows[static_cast<std::size_t>(y)].i0);
-      });
-  reduced_frame_schedule(
-      g, [](int) {},
-      [&](int y, int k) {
-        const int i0 = g.bilinear_rows[static_cast<std::size_t>(y)].i0;
-        p.reduced_lines = std::max(p.reduced_lines, k - i0 + 1);
-        p.reduced_latency = std::max(p.reduced_latency, k - i0);
-      });
+  FullSchedule full;
+  for (int y_in = 0; y_in < g.full.height; ++y_in) {
+    full.after_input(
+        g, y_in,
+        [&](int k, int in) {
+          p.gauss_lines = std::max(p.gauss_lines, in - g.gauss_rows[static_cast<std::size_t>(k)].first() + 1);
+        },
+        [&](int y, int in, int ready) {
+          p.delay_lines = std::max(p.delay_lines, in - y + 1);
+          p.full_latency = std::max(p.full_latency, in - y);
+          p.low_lines = std::max(p.low_lines, ready - g.bilinear_rows[static_cast<std::size_t>(y)].i0);
+        });
+  }
+  ReducedSchedule reduced;
+  for (int k = 0; k < g.reduced.height; ++k) {
+    reduced.after_input(g, k, [&](int y, int in) {
+      const int i0 = g.bilinear_rows[static_cast<std::size_t>(y)].i0;
+      p.reduced_lines = std::max(p.reduced_lines, in - i0 + 1);
+      p.reduced_latency = std::max(p.reduced_latency, in - i0);
+    });
+  }
   return p;
 }
 
 }  // namespace
+
+namespace {
+
+// Copies a line within a ring (a lost line takes the concealed line above it); with a one-line ring the two are the
+// same slot and the line simply stays.
+template <typename T>
+void repeat_line(LineRing<T>& ring, int line, int samples) {
+  const T* above = ring.read(line - 1);
+  T* slot = ring.write(line);
+  if (slot != above) std::copy(above, above + samples, slot);
+}
+
+}  // namespace
+
+namespace fixed_detail {
+
+// One view in flight through the streaming schedule, line by line.
+//
+// Concealment in raster order (the reference's rules, line by line as the lines arrive):
+//   * a lost line below an intact one repeats the line just above it, which the input ring (E_t delay or U of i)
+//     still holds already concealed: by induction that is the nearest intact line above. No storage is added.
+//   * lost lines above the first intact line of the view (nothing intact above them) are copies of that line (the
+//     nearest intact line below): no data is kept for them, and every read of such a line reads the first intact
+//     line instead, like a replicate border moved down to it. Work that needs them waits for that line, so such a
+//     view's output starts up to first_intact lines later than normal.
+//   * a lost line of a reduced frame with a stored d_{t-1} takes that frame store's row (an extra row read). Whether
+//     the view is partial or lost whole is known at its first intact line, so lost lines above it are taken then.
+// Lost lines of a full frame then show L_t (full_pixel), as in the frame-at-a-time schedule. A view without any
+// intact line is a lost view (decode_lost): nothing of it is computed before its end.
+class StreamingView {
+ public:
+  StreamingView(FixedDecoderCore& core, const FrameMeta& meta)
+      : core_(core),
+        meta_(meta),
+        // Looked up before begin(), which resets an eye whose view size changed (as classify() does for decode).
+        substitute_(core.concealment_substitute(meta)),
+        intact_(static_cast<std::size_t>(meta.height), 0) {}
+
+  const FrameMeta& meta() const { return meta_; }
+  int lines_pushed() const { return pushed_; }
+  int input_samples() const { return 3 * meta_.width; }
+  int rows_ready() const {
+    if (!started_) return 0;
+    return full_ ? full_schedule_.next_output : reduced_schedule_.next_output;
+  }
+  const std::uint16_t* drive_row(int y) const { return out_.frame.drive_codes.ptr<std::uint16_t>(y); }
+
+  // codes: input_samples() link codes, already checked; null for a lost line.
+  void push(const std::uint16_t* codes) {
+    const int line = pushed_++;
+    intact_[static_cast<std::size_t>(line)] = codes != nullptr ? 1 : 0;
+    lost_lines_ += codes != nullptr ? 0 : 1;
+    if (!started_) {
+      if (codes == nullptr) return;  // nothing intact yet: lost whole, or held back until the first intact line
+      start(line);
+      // With a d_{t-1} to take them from, the lost lines above are concealed now, in order; without one `first_` is
+      // this line and they are read as it.
+      for (int k = first_; k < line; ++k) input(k, nullptr);
+    }
+    input(line, codes);
+  }
+
+  DecodedFrame finish() {
+    if (!started_) return core_.decode_lost(meta_, kWho);
+    out_.concealed_lines = lost_lines_;
+    EyeState& eye = *eye_;
+    if (full_) {
+      eye.have_residual = true;
+      eye.residual_index = meta_.index;
+      eye.residual = residual_store_;
+      eye.previous_low = low_store_;
+      return core_.finish(std::move(out_), eye, true, false);
+    }
+    eye.have_residual = false;
+    eye.residual.release();
+    eye.previous_low.release();
+    return core_.finish(std::move(out_), eye, false, residual_applies_);
+  }
+
+ private:
+  bool lost(int line) const { return intact_[static_cast<std::size_t>(line)] == 0; }
+  // Lines above the first intact line read as the first intact line.
+  int source_line(int line) const { return std::max(line, first_); }
+
+  void start(int first_intact) {
+    started_ = true;
+    first_ = substitute_.empty() ? first_intact : 0;
+    eye_ = &core_.begin(meta_);
+    EyeState& eye = *eye_;
+    g_ = &core_.kernels().geometry(eye.full_size);
+    const Geometry& g = *g_;
+    const StreamPlan plan = plan_for(g);
+    full_ = meta_.parity == Parity::Full;
+    out_ = core_.start_output(meta_, eye);
+    out_.full = full_;
+    core_.begin_lcd(out_, eye);
+    const int full_samples = 3 * g.full.width;
+    const int reduced_samples = 3 * g.reduced.width;
+    if (full_) {
+      delay_.emplace("E_t delay", plan.delay_lines, full_samples);
+      gauss_.emplace("vertical Gaussian", plan.gauss_lines, reduced_samples);
+      low_lines_.emplace("U of d_t", plan.low_lines, reduced_samples);
+      residual_store_ = reusable_plane(eye.spare_planes, g.full, CV_32SC3);  // frame store rho
+      low_store_ = reusable_plane(eye.spare_planes, g.reduced, CV_16UC3);    // frame store d_t
+      return;
+    }
+    // meta.index >= 0 (checked by check_view_header), so index - 1 cannot overflow.
+    residual_applies_ = eye.have_residual && eye.residual_index == meta_.index - 1;
+    in_lines_.emplace("U of i", plan.reduced_lines, reduced_samples);
+    // DESIGN §7 static skip: the line comparator's result for each line held in the U buffer (2 bits per line).
+    gated_ = residual_applies_ && core_.skipping();
+    line_flags_.emplace("U of i comparator flags", plan.reduced_lines, 1);
+  }
+
+  // Input line `line` (codes null: lost) and the schedule's steps after it.
+  void input(int line, const std::uint16_t* codes) {
+    if (full_) {
+      full_input(line, codes);
+      full_schedule_.after_input(
+          *g_, line, [this](int k, int) { reduced_row(k); }, [this](int y, int, int) { full_output(y); });
+    } else {
+      reduced_input(line, codes);
+      reduced_schedule_.after_input(*g_, line, [this](int y, int) { reduced_output(y); });
+    }
+  }
+
+  void full_input(int y_in, const std::uint16_t* codes) {
+    const Geometry& g = *g_;
+    const int full_samples = 3 * g.full.width;
+    if (codes == nullptr) {
+      repeat_line(*delay_, y_in, full_samples);
+    } else {
+      std::copy(codes, codes + full_samples, delay_->write(y_in));
+    }
+    const std::uint16_t* in = delay_->read(y_in);
+    Raw* h = gauss_->write(y_in);
+    const FixedKernels& kernels = core_.kernels();
+    for (int k = 0; k < g.reduced.width; ++k) {
+      for (int ch = 0; ch < 3; ++ch) {
+        h[3 * k + ch] = kernels.gaussian_horizontal(in, g.gauss_cols[static_cast<std::size_t>(k)], ch);
+      }
+    }
+  }
+
+  void reduced_row(int k) {
+    const Geometry& g = *g_;
+    const PolyphaseTaps& taps = g.gauss_rows[static_cast<std::size_t>(k)];
+    tap_rows_.clear();
+    for (int index : taps.index) tap_rows_.push_back(gauss_->read(source_line(index)));
+    std::uint16_t* d = low_lines_->write(k);
+    std::uint16_t* stored = low_store_.ptr<std::uint16_t>(k);
+    const FixedKernels& kernels = core_.kernels();
+    const int reduced_samples = 3 * g.reduced.width;
+    for (int i = 0; i < reduced_samples; ++i) {
+      stored[i] = kernels.gaussian_vertical(tap_rows_.data(), taps, i);
+      d[i] = stored[i];
+    }
+  }
+
+  void full_output(int y) {
+    const Geometry& g = *g_;
+    const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    const std::uint16_t* codes_row = delay_->read(source_line(y));
+    const std::uint16_t* low0 = low_lines_->read(row.i0);
+    const std::uint16_t* low1 = low_lines_->read(row.i1);
+    std::int32_t* residual_row = residual_store_.ptr<std::int32_t>(y);
+    const bool lost_line = lost(y);
+    for (int x = 0; x < g.full.width; ++x) {
+      core_.full_pixel(out_, *eye_, g, y, x, codes_row, low0, low1, residual_row, lost_line);
+    }
+    core_.end_full_line(out_, *eye_, y, residual_row);
+  }
+
+  void reduced_input(int k, const std::uint16_t* codes) {
+    const int reduced_samples = 3 * g_->reduced.width;
+    if (codes != nullptr) {
+      std::copy(codes, codes + reduced_samples, in_lines_->write(k));
+    } else if (!substitute_.empty()) {
+      const std::uint16_t* stored = substitute_.ptr<std::uint16_t>(k);  // d_{t-1} frame store row k
+      std::copy(stored, stored + reduced_samples, in_lines_->write(k));
+    } else {
+      repeat_line(*in_lines_, k, reduced_samples);
+    }
+    if (gated_) {  // compared as the line enters the U buffer, against the d_{t-1} frame store row k
+      *line_flags_->write(k) =
+          FixedKernels::compare_line(eye_->previous_low.ptr<std::uint16_t>(k), in_lines_->read(k), reduced_samples);
+    }
+  }
+
+  void reduced_output(int y) {
+    const Geometry& g = *g_;
+    EyeState& eye = *eye_;
+    const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    const std::uint16_t* in0 = in_lines_->read(source_line(row.i0));
+    const std::uint16_t* in1 = in_lines_->read(source_line(row.i1));
+    ReducedLineGate gate;
+    if (gated_) {
+      // Lines above `first_` (never held) do not skip.
+      gate = core_.reduced_line_gate(out_, eye, g, y, [this](int k) -> std::uint8_t {
+        return k < first_ ? 0 : *line_flags_->read(k);
+      });
+    }
+    const bool read_previous = residual_applies_ && !gate.motion_static;
+    const std::uint16_t* prev0 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
+    const std::uint16_t* prev1 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
+    const std::int32_t* residual_row =
+        residual_applies_ && !gate.residual_zero ? eye.residual.ptr<std::int32_t>(y) : nullptr;
+    for (int x = 0; x < g.full.width; ++x) {
+      core_.reduced_pixel(out_, eye, g, y, x, in0, in1, prev0, prev1, residual_row, gated_ ? &gate : nullptr);
+    }
+  }
+
+  FixedDecoderCore& core_;
+  FrameMeta meta_;
+  cv::Mat substitute_;  // reduced frames: the eye's d_{t-1} frame store (codes) for lost lines; empty: none
+  std::vector<std::uint8_t> intact_;  // per input line pushed; 0 = lost
+  int pushed_ = 0;
+  int lost_lines_ = 0;
+  bool started_ = false;  // the first intact line has arrived
+  int first_ = 0;         // lines above it are read as it (see source_line)
+  bool full_ = false;
+  EyeState* eye_ = nullptr;
+  const Geometry* g_ = nullptr;
+  FrameOutput out_;
+  FullSchedule full_schedule_;
+  ReducedSchedule reduced_schedule_;
+  // Full frames: line buffers and the frame stores this frame writes.
+  std::optional<LineRing<std::uint16_t>> delay_;
+  std::optional<LineRing<Raw>> gauss_;
+  std::optional<LineRing<std::uint16_t>> low_lines_;
+  cv::Mat residual_store_;
+  cv::Mat low_store_;
+  std::vector<const Raw*> tap_rows_;
+  // Reduced frames.
+  bool residual_applies_ = false;
+  bool gated_ = false;
+  std::optional<LineRing<std::uint16_t>> in_lines_;
+  std::optional<LineRing<std::uint8_t>> line_flags_;
+};
+
+}  // namespace fixed_detail
 
 FixedStreamingDecoder::FixedStreamingDecoder(FixedDecoderConfig config)
     : core_(std::make_unique<FixedDecoderCore>(std::move(config))) {}
@@ -185,166 +436,89 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
   return r;
 }
 
-DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame) { return decode_impl(frame, nullptr); }
+DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame) { return decode_checked(frame, {}); }
 
 DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
-  detail::Concealment lost;
-  switch (core_->classify(frame, line_intact, lost, "FixedStreamingDecoder")) {
-    case detail::Arrival::Whole: return decode_impl(frame, nullptr);
-    case detail::Arrival::Lost: return core_->decode_lost(frame.meta, "FixedStreamingDecoder");
-    case detail::Arrival::Partial: break;
-  }
-  return decode_impl(frame, &lost);
+  return decode_checked(frame, line_intact);
 }
 
 DecodedFrame FixedStreamingDecoder::decode_lost(const FrameMeta& meta) {
-  return core_->decode_lost(meta, "FixedStreamingDecoder");
+  if (view_) throw std::logic_error(std::string(kWho) + ": decode_lost while " + detail::frame_name(view_->meta()) + " is open");
+  return core_->decode_lost(meta, kWho);
 }
 
-namespace {
-
-// Copies a line within a ring (a lost line takes the concealed line above it); with a one-line ring the two are the
-// same slot and the line simply stays.
-template <typename T>
-void repeat_line(LineRing<T>& ring, int line, int samples) {
-  const T* above = ring.read(line - 1);
-  T* slot = ring.write(line);
-  if (slot != above) std::copy(above, above + samples, slot);
-}
-
-}  // namespace
-
-// Concealment in raster order (the reference's rules, line by line as the lines arrive):
-//   * a lost line below an intact one repeats the line just above it, which the input ring (E_t delay or U of i)
-//     still holds already concealed: by induction that is the nearest intact line above. No storage is added.
-//   * lost lines above the first intact line of the view (nothing intact above them) are copies of that line (the
-//     nearest intact line below): no data is kept for them, and every read of such a line reads the first intact
-//     line instead, like a replicate border moved down to it. Work that needs them waits for that line, so such a
-//     view's output starts up to first_intact lines later than normal.
-//   * a lost line of a reduced frame with a stored d_{t-1} takes that frame store's row (an extra row read).
-// Lost lines of a full frame then show L_t (full_pixel), as in the frame-at-a-time schedule.
-DecodedFrame FixedStreamingDecoder::decode_impl(const LinkFrame& frame, const detail::Concealment* lost) {
-  fixed_detail::EyeState& eye = core_->begin(frame, "FixedStreamingDecoder");
-  fixed_detail::FixedKernels& kernels = core_->kernels();
-  const Geometry& g = kernels.geometry(eye.full_size);
-  const StreamPlan plan = plan_for(g);
-  fixed_detail::FrameOutput out = core_->start_output(frame, eye);
-  out.full = frame.meta.parity == Parity::Full;
-  out.concealed_lines = lost != nullptr ? lost->lost_lines : 0;
-  core_->begin_lcd(out, eye);
-  const int full_samples = 3 * g.full.width;
-  const int reduced_samples = 3 * g.reduced.width;
-  const auto is_lost = [lost](int line) { return lost != nullptr && lost->lost(line); };
-  // Lines above the first intact line read as the first intact line.
-  const int first = lost != nullptr && lost->substitute.empty() ? lost->first_intact : 0;
-  const auto source_line = [first](int line) { return std::max(line, first); };
-
-  if (frame.meta.parity == Parity::Full) {
-    LineRing<std::uint16_t> delay("E_t delay", plan.delay_lines, full_samples);
-    LineRing<Raw> gauss("vertical Gaussian", plan.gauss_lines, reduced_samples);
-    LineRing<std::uint16_t> low_lines("U of d_t", plan.low_lines, reduced_samples);
-    cv::Mat residual_store = fixed_detail::reusable_plane(eye.spare_planes, g.full, CV_32SC3);  // frame store rho
-    cv::Mat low_store = fixed_detail::reusable_plane(eye.spare_planes, g.reduced, CV_16UC3);    // frame store d_t
-    std::vector<const Raw*> tap_rows;
-
-    full_frame_schedule(
-        g,
-        [&](int y_in) {
-          if (y_in < first) return;  // lost, nothing intact above: filled from line `first` when it arrives
-          if (is_lost(y_in)) {
-            repeat_line(delay, y_in, full_samples);
-          } else {
-            const std::uint16_t* received = frame.codes.ptr<std::uint16_t>(y_in);
-            std::copy(received, received + full_samples, delay.write(y_in));
-          }
-          const std::uint16_t* in = delay.read(y_in);
-          Raw* h = gauss.write(y_in);
-          for (int k = 0; k < g.reduced.width; ++k) {
-            for (int ch = 0; ch < 3; ++ch) {
-              h[3 * k + ch] = kernels.gaussian_horizontal(in, g.gauss_cols[static_cast<std::size_t>(k)], ch);
-            }
-          }
-        },
-        [&](int k, int) {
-          const fixed_detail::PolyphaseTaps& taps = g.gauss_rows[static_cast<std::size_t>(k)];
-          tap_rows.clear();
-          for (int index : taps.index) tap_rows.push_back(gauss.read(source_line(index)));
-          std::uint16_t* d = low_lines.write(k);
-          std::uint16_t* stored = low_store.ptr<std::uint16_t>(k);
-          for (int i = 0; i < reduced_samples; ++i) {
-            stored[i] = kernels.gaussian_vertical(tap_rows.data(), taps, i);
-            d[i] = stored[i];
-          }
-        },
-        [&](int y, int, int) {
-          const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
-          const std::uint16_t* codes_row = delay.read(source_line(y));
-          const std::uint16_t* low0 = low_lines.read(row.i0);
-          const std::uint16_t* low1 = low_lines.read(row.i1);
-          std::int32_t* residual_row = residual_store.ptr<std::int32_t>(y);
-          const bool lost_line = is_lost(y);
-          for (int x = 0; x < g.full.width; ++x) {
-            core_->full_pixel(out, eye, g, y, x, codes_row, low0, low1, residual_row, lost_line);
-          }
-          core_->end_full_line(out, eye, y, residual_row);
-        },
-        first);
-    eye.have_residual = true;
-    eye.residual_index = frame.meta.index;
-    eye.residual = residual_store;
-    eye.previous_low = low_store;
-    return core_->finish(std::move(out), eye, true, false);
+DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::span<const std::uint8_t> line_intact) {
+  detail::Concealment lost;
+  // The mask first, as the other decoders check it; a view with no intact line is a lost view and its codes are not
+  // looked at.
+  if (detail::classify_arrival(frame, line_intact, lost, kWho) == detail::Arrival::Lost) return decode_lost(frame.meta);
+  detail::check_link_frame(frame, core_->config().decoder.link, kWho);
+  begin_view(frame.meta);
+  for (int y = 0; y < frame.codes.rows; ++y) {
+    take_line(frame.codes.ptr<std::uint16_t>(y), line_intact.empty() || line_intact[static_cast<std::size_t>(y)] != 0);
   }
+  return end_view();
+}
 
-  // frame.meta.index >= 0 (checked by begin), so index - 1 cannot overflow.
-  const bool residual_applies = eye.have_residual && eye.residual_index == frame.meta.index - 1;
-  LineRing<std::uint16_t> in_lines("U of i", plan.reduced_lines, reduced_samples);
-  // DESIGN §7 static skip: the line comparator's result for each line held in the U buffer (2 bits per line).
-  const bool gated = residual_applies && core_->skipping();
-  LineRing<std::uint8_t> line_flags("U of i comparator flags", plan.reduced_lines, 1);
-  reduced_frame_schedule(
-      g,
-      [&](int k) {
-        if (k < first) return;
-        if (!is_lost(k)) {
-          const std::uint16_t* in = frame.codes.ptr<std::uint16_t>(k);
-          std::copy(in, in + reduced_samples, in_lines.write(k));
-        } else if (!lost->substitute.empty()) {
-          const std::uint16_t* stored = lost->substitute.ptr<std::uint16_t>(k);  // d_{t-1} frame store row k
-          std::copy(stored, stored + reduced_samples, in_lines.write(k));
-        } else {
-          repeat_line(in_lines, k, reduced_samples);
-        }
-        if (gated) {  // compared as the line enters the U buffer, against the d_{t-1} frame store row k
-          *line_flags.write(k) = fixed_detail::FixedKernels::compare_line(eye.previous_low.ptr<std::uint16_t>(k),
-                                                                          in_lines.read(k), reduced_samples);
-        }
-      },
-      [&](int y, int) {
-        const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
-        const std::uint16_t* in0 = in_lines.read(source_line(row.i0));
-        const std::uint16_t* in1 = in_lines.read(source_line(row.i1));
-        fixed_detail::ReducedLineGate gate;
-        if (gated) {
-          // Lines above `first` (never held) do not skip.
-          gate = core_->reduced_line_gate(out, eye, g, y, [&](int k) -> std::uint8_t {
-            return k < first ? 0 : *line_flags.read(k);
-          });
-        }
-        const bool read_previous = residual_applies && !gate.motion_static;
-        const std::uint16_t* prev0 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
-        const std::uint16_t* prev1 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
-        const std::int32_t* residual_row =
-            residual_applies && !gate.residual_zero ? eye.residual.ptr<std::int32_t>(y) : nullptr;
-        for (int x = 0; x < g.full.width; ++x) {
-          core_->reduced_pixel(out, eye, g, y, x, in0, in1, prev0, prev1, residual_row, gated ? &gate : nullptr);
-        }
-      },
-      first);
-  eye.have_residual = false;
-  eye.residual.release();
-  eye.previous_low.release();
-  return core_->finish(std::move(out), eye, false, residual_applies);
+void FixedStreamingDecoder::begin_view(const FrameMeta& meta) {
+  if (view_) {
+    throw std::logic_error(std::string(kWho) + ": " + detail::frame_name(meta) + " begun while " +
+                           detail::frame_name(view_->meta()) + " is still open");
+  }
+  detail::check_view_header(meta, core_->config().decoder.link, kWho);
+  view_ = std::make_unique<fixed_detail::StreamingView>(*core_, meta);
+}
+
+int FixedStreamingDecoder::push_line(std::span<const std::uint16_t> codes, bool intact) {
+  if (!view_) throw std::logic_error(std::string(kWho) + ": a line pushed without an open view");
+  const FrameMeta& meta = view_->meta();
+  const std::string what = std::string(kWho) + ": " + detail::frame_name(meta) + ": ";
+  if (view_->lines_pushed() >= meta.height) {
+    throw std::logic_error(what + "a line pushed after all " + std::to_string(meta.height) + " lines of the view");
+  }
+  if (intact) {
+    if (codes.size() != static_cast<std::size_t>(view_->input_samples())) {
+      throw std::invalid_argument(what + "line " + std::to_string(view_->lines_pushed()) + " has " +
+                                  std::to_string(codes.size()) + " samples, the view's lines have " +
+                                  std::to_string(view_->input_samples()) + " (3 x " + std::to_string(meta.width) +
+                                  ")");
+    }
+    detail::check_line_codes(meta, view_->lines_pushed(), codes, meta.bits, kWho);
+  }
+  take_line(intact ? codes.data() : nullptr, intact);
+  return view_->rows_ready();
+}
+
+void FixedStreamingDecoder::take_line(const std::uint16_t* codes, bool intact) {
+  try {
+    view_->push(intact ? codes : nullptr);
+  } catch (...) {
+    view_.reset();  // half a line computed: the view cannot go on
+    throw;
+  }
+}
+
+int FixedStreamingDecoder::rows_ready() const { return view_ ? view_->rows_ready() : 0; }
+
+std::span<const std::uint16_t> FixedStreamingDecoder::drive_row(int y) const {
+  if (!view_ || y < 0 || y >= view_->rows_ready()) {
+    throw std::out_of_range(std::string(kWho) + ": output row " + std::to_string(y) + " is not ready");
+  }
+  return {view_->drive_row(y), static_cast<std::size_t>(3 * view_->meta().full_width)};
+}
+
+bool FixedStreamingDecoder::view_open() const { return view_ != nullptr; }
+int FixedStreamingDecoder::lines_pushed() const { return view_ ? view_->lines_pushed() : 0; }
+
+DecodedFrame FixedStreamingDecoder::end_view() {
+  if (!view_) throw std::logic_error(std::string(kWho) + ": end of view without an open view");
+  if (view_->lines_pushed() != view_->meta().height) {
+    throw std::logic_error(std::string(kWho) + ": " + detail::frame_name(view_->meta()) + ": end of view after " +
+                           std::to_string(view_->lines_pushed()) + " of its " + std::to_string(view_->meta().height) +
+                           " lines");
+  }
+  std::unique_ptr<fixed_detail::StreamingView> view = std::move(view_);
+  return view->finish();
 }
 
 }  // namespace trm

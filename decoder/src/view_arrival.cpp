@@ -4,6 +4,7 @@
 
 #include "trm/resample.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace trm::detail {
@@ -56,6 +57,39 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
   if (highest > (1 << link.bits) - 1) {
     throw std::invalid_argument(what + "code " + std::to_string(static_cast<int>(highest)) + " exceeds the " +
                                 std::to_string(link.bits) + "-bit range");
+  }
+}
+
+void check_view_header(const FrameMeta& meta, const EncoderConfig& link, const std::string& who) {
+  const std::string what = who + ": " + frame_name(meta) + ": ";
+  check_view_meta(meta, what);
+  if (meta.bits != link.bits) {
+    throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
+                                std::to_string(link.bits));
+  }
+  if (meta.transfer != link.transfer) {
+    throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
+                                to_string(link.transfer));
+  }
+  const cv::Size full(meta.full_width, meta.full_height);
+  const cv::Size expected = meta.parity == Parity::Full
+                                ? full
+                                : cv::Size(reduced_size(full.width, link.reduction),
+                                           reduced_size(full.height, link.reduction));
+  if (cv::Size(meta.width, meta.height) != expected) {
+    throw std::invalid_argument(what + "the metadata says " + size_text(meta.width, meta.height) + " but a " +
+                                to_string(meta.parity) + " frame of a " + size_text(full.width, full.height) +
+                                " view at r=" + std::to_string(link.reduction) + " must be " +
+                                size_text(expected.width, expected.height));
+  }
+}
+
+void check_line_codes(const FrameMeta& meta, int line, std::span<const std::uint16_t> codes, int bits,
+                      const std::string& who) {
+  const std::uint16_t highest = codes.empty() ? 0 : *std::max_element(codes.begin(), codes.end());
+  if (highest > (1 << bits) - 1) {
+    throw std::invalid_argument(who + ": " + frame_name(meta) + ": line " + std::to_string(line) + ": code " +
+                                std::to_string(highest) + " exceeds the " + std::to_string(bits) + "-bit range");
   }
 }
 

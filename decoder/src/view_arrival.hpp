@@ -20,6 +20,14 @@ std::string frame_name(const FrameMeta& meta);
 // the view's full or reduced size, and no code beyond the link bit depth.
 void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who);
 
+// The metadata checks of check_link_frame for a view that arrives line by line (no codes yet): valid metadata, the
+// link's bits and transfer, and metadata width x height the view's full or reduced size.
+void check_view_header(const FrameMeta& meta, const EncoderConfig& link, const std::string& who);
+// The code check of check_link_frame for one line of such a view: throws std::invalid_argument
+// "<who>: <frame name>: line <y>: code <c> exceeds the <b>-bit range".
+void check_line_codes(const FrameMeta& meta, int line, std::span<const std::uint16_t> codes, int bits,
+                      const std::string& who);
+
 // Throws std::invalid_argument "<who>: lost <frame name>: <problem>" unless the metadata of a view that never
 // arrived is valid.
 void check_lost_view(const FrameMeta& meta, const std::string& who);
@@ -47,6 +55,16 @@ Arrival classify_arrival(const LinkFrame& frame, std::span<const std::uint8_t> l
 // The d_{t-1} a partial reduced view's lost lines repeat: the eye's stored d_t when the eye holds a residual and a
 // d_t of the view's reduced size, looked up before a change of view size resets the eye; else empty. Over the
 // reference's and the fixed-point decoders' eye maps (same member names).
+template <typename EyeMap>
+cv::Mat concealment_substitute(const EyeMap& eyes, const FrameMeta& meta) {
+  if (meta.parity != Parity::Reduced) return cv::Mat();
+  const auto found = eyes.find(meta.eye);
+  if (found == eyes.end() || !found->second.have_residual ||
+      found->second.previous_low.size() != cv::Size(meta.width, meta.height)) {
+    return cv::Mat();
+  }
+  return found->second.previous_low;
+}
 template <typename EyeMap>
 cv::Mat concealment_substitute(const EyeMap& eyes, const LinkFrame& frame) {
   if (frame.meta.parity != Parity::Reduced) return cv::Mat();

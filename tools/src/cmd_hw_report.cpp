@@ -29,10 +29,8 @@ void register_hw_report(CLI::App& app, Action& action) {
       if (!json->empty()) io::check_file_target(*json);  // before --out is replaced
       FixedDecoderConfig config = fixed_config_of(*options);
       const FixedStreamingDecoder decoder(config);  // validates the configuration
-      Json report;
-      report["parameters"] = {{"size", {options->width, options->height}},
-                              {"decoder", fixed_decoder_json(config)}};
-      report["hardware"] = hardware_json(decoder.report(cv::Size(options->width, options->height)));
+      const cv::Size size(options->width, options->height);
+      const Json report = hw_report_json(config, size, decoder.report(size));
       const std::string text = report.dump(2) + "\n";
       if (!out->empty()) {
         OutputDir dir(*out);

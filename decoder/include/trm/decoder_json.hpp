@@ -20,4 +20,13 @@ nlohmann::ordered_json fixed_decoder_json(const FixedDecoderConfig& config);
 DecoderConfig decoder_config_from_json(const nlohmann::json& json);
 FixedDecoderConfig fixed_decoder_config_from_json(const nlohmann::json& json);
 
+// The streaming decoder as hardware (FixedStreamingReport): buffers, ROMs, arithmetic per stage, latency, on-/off-chip
+// totals and the paper's frame-store comparison; the one writer for `trm hw-report`, `trm run`'s report.json and
+// the C API (trm_c.h).
+nlohmann::ordered_json hardware_json(const FixedStreamingReport& report);
+// The document `trm hw-report` writes: {"parameters": {"size": [w, h], "decoder": fixed_decoder_json}, "hardware":
+// hardware_json}.
+nlohmann::ordered_json hw_report_json(const FixedDecoderConfig& config, cv::Size full,
+                                      const FixedStreamingReport& report);
+
 }  // namespace trm

@@ -251,6 +251,7 @@ struct FixedStageTaps {
 
 namespace fixed_detail {
 class FixedDecoderCore;
+class StreamingView;
 }
 namespace detail {
 struct Concealment;
@@ -285,6 +286,10 @@ class FixedFrameDecoder : public HeadsetDecoder {
 };
 
 // Line-buffered raster schedule (the hardware model); bit-identical to FixedFrameDecoder.
+//
+// Incremental, as the hardware sees a view: begin_view, push_line once per input line in raster order (each push
+// produces the output rows the schedule has ready then, in raster order), end_view. decode() is that sequence over a
+// whole frame.
 class FixedStreamingDecoder : public HeadsetDecoder {
  public:
   explicit FixedStreamingDecoder(FixedDecoderConfig config);
@@ -308,9 +313,31 @@ class FixedStreamingDecoder : public HeadsetDecoder {
   // Latency, line buffers / frame stores, ROMs and arithmetic per stage for a view of the given full size.
   FixedStreamingReport report(cv::Size full) const;
 
+  // Opens a view as the link announces it (meta.width x meta.height: the size sent). Throws std::invalid_argument
+  // for a view the decoder cannot take (the checks of decode), std::logic_error while another view is open.
+  void begin_view(const FrameMeta& meta);
+  // The next input line of the open view: 3 * meta.width link codes, or a line lost on the link (intact false: codes
+  // are not read; concealed as decode(frame, line_intact) conceals it). Returns rows_ready(). Throws
+  // std::invalid_argument for a wrong length or a code beyond the link range and std::logic_error without an open
+  // view or after its last line; nothing is taken then.
+  int push_line(std::span<const std::uint16_t> codes, bool intact = true);
+  // Output rows of the open view that are final: rows 0 .. rows_ready() - 1. Lost lines above a view's first intact
+  // line hold its rows back until that line arrives; a view with no intact line has its rows at end_view.
+  int rows_ready() const;
+  // The drive codes (3 * full width, R G B) of ready row y of the open view.
+  std::span<const std::uint16_t> drive_row(int y) const;
+  bool view_open() const;
+  int lines_pushed() const;
+  // Ends the open view once every line is pushed: what decode() returns for it (frame stores and counters final).
+  // Throws std::logic_error without an open view or with lines missing.
+  DecodedFrame end_view();
+
  private:
   std::unique_ptr<fixed_detail::FixedDecoderCore> core_;
-  DecodedFrame decode_impl(const LinkFrame& frame, const detail::Concealment* lost);
+  std::unique_ptr<fixed_detail::StreamingView> view_;
+  // The lines of a frame already checked whole (check_link_frame), through the incremental path.
+  DecodedFrame decode_checked(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  void take_line(const std::uint16_t* codes, bool intact);
 };
 
 }  // namespace trm

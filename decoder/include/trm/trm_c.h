@@ -84,7 +84,8 @@ typedef struct trm_config {
   int32_t resample_space;  /* TRM_RESAMPLE_* */
   double sensitivity;      /* motion sensitivity s (Eq. 6), 0 .. 255 or INFINITY */
   const char* panel;       /* panel spec as `trm --panel` takes it: "vive", "rift", "generic", "gamma:G",
-                              "gamma:GR,GG,GB", "lcd", "lcd:p1,p2,p3,p4,gamma"; NULL means "vive". Copied. */
+                              "gamma:GR,GG,GB", "lcd", "lcd:p1,p2,p3,p4,gamma"; NULL: the C++ default
+                              (trm::Panel{}, OLED gamma 2.2). Read during create only. */
   int32_t output_bits;     /* drive code depth, 8 or 10 */
   int32_t lcd_history;     /* TRM_LCD_HISTORY_* */
   int32_t skip_unneeded;   /* nonzero: DESIGN section 7 skips (bit-identical output either way) */
@@ -118,8 +119,8 @@ const char* trm_last_error(void);
 /* The message of the last failed call on d ("" if none); with d NULL, trm_last_error(). */
 const char* trm_decoder_last_error(const trm_decoder* d);
 
-/* Defaults: r = 0.5, sigma default, 8-bit sRGB link, encoded resample space, s = 10, "vive", 8-bit drive, history
- * wanted, skips on (the decoder's own defaults). */
+/* The C++ decoder's defaults (trm::FixedDecoderConfig{}): r = 0.5, sigma default, 8-bit sRGB link, encoded
+ * resample space, s = 10, panel NULL, 8-bit drive, history wanted, skips on. */
 void trm_config_defaults(trm_config* config);
 
 /* Creates a decoder from a fixed-point decoder configuration as JSON text (NUL-terminated): the object reports carry
