@@ -15,7 +15,7 @@
 //     whatever the latency, with its sink stalling at random so its backpressure is exercised.
 // Until a team's RTL takes the slot (+define+TRM_DUT=their_module, same ports), a second model instance sits there.
 //
-// Plusargs: +vectors=DIR +golden=FILE +scene=NAME +panel=NAME +trm_config=DIR/report.json
+// Plusargs: +vectors=DIR +golden=FILE +scene=NAME +panel=NAME +trm_config=DIR/report.json [+trm_dut_defect_row=Y]
 `ifndef TRM_DUT
 `define TRM_DUT trm_decoder_model
 `endif
@@ -239,13 +239,15 @@ module trm_golden_tb;
       .in_full_height, .in_intact, .in_samples, .in_codes, .out_valid(dut_out_valid), .out_ready(dut_out_ready),
       .out_row(dut_out_row), .out_last(dut_out_last), .out_samples(dut_out_samples), .out_drive(dut_out_drive));
 
-  // The DUT's sink stalls about one cycle in three (a 16-bit Fibonacci LFSR, taps 16 14 13 11).
+  // The DUT's sink stalls about one cycle in four (a 16-bit Fibonacci LFSR, taps 16 14 13 11).
   logic [15:0] lfsr = 16'hace1;
   always @(posedge clk) lfsr <= {lfsr[14:0], lfsr[15] ^ lfsr[13] ^ lfsr[12] ^ lfsr[10]};
   assign dut_out_ready = lfsr[1:0] != 2'b00;
 
   // ---- the scoreboard -------------------------------------------------------------------------------------------
   int model_view = 0, model_next_row = 0, dut_view = 0, dut_next_row = 0;
+  int dut_defect_row = -1;
+  initial if (!$value$plusargs("trm_dut_defect_row=%d", dut_defect_row)) dut_defect_row = -1;
   longint unsigned model_hash = FNV_OFFSET;
   int code_mismatches = 0, hash_mismatches = 0, rows_checked = 0, dut_rows_compared = 0, dut_mismatches = 0;
   logic [15:0] model_rows [MAX_FRAMES][MAX_LINES][MAX_SAMPLES];
@@ -308,6 +310,9 @@ module trm_golden_tb;
       if (int'(dut_out_samples) != drive_samples[v])
         $fatal(1, "DUT: view %0d row %0d has %0d samples, expected %0d", v, y, dut_out_samples, drive_samples[v]);
       for (int i = 0; i < drive_samples[v]; i++) dut_rows[v][y][i] = dut_out_drive[i];
+      // +trm_dut_defect_row=Y: the DUT's row Y of the first view arrives with one code off by one, to show the
+      // scoreboard fails a DUT that differs in a single code.
+      if (v == 0 && y == dut_defect_row) dut_rows[v][y][0] = dut_rows[v][y][0] ^ 16'd1;
       dut_has[v][y] = 1'b1;
       if (model_has[v][y]) compare_dut_row(v, y);
       dut_next_row = y + 1;
