@@ -443,7 +443,10 @@ DecodedFrame FixedStreamingDecoder::decode(const LinkFrame& frame, std::span<con
 }
 
 DecodedFrame FixedStreamingDecoder::decode_lost(const FrameMeta& meta) {
-  if (view_) throw std::logic_error(std::string(kWho) + ": decode_lost while " + detail::frame_name(view_->meta()) + " is open");
+  if (view_) {
+    throw std::logic_error(std::string(kWho) + ": decode_lost while " + detail::frame_name(view_->meta()) +
+                           " is still open");
+  }
   return core_->decode_lost(meta, kWho);
 }
 

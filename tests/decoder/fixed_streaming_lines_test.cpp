@@ -86,7 +86,8 @@ void expect_line_by_line(const std::vector<LinkFrame>& frames, const FixedDecode
       ASSERT_EQ(rows, streaming.rows_ready()) << where;
       ASSERT_GE(rows, shown) << where << " line " << y_in;
       if (mask.empty()) {
-        const int oracle = static_cast<int>(std::count_if(ready.begin(), ready.end(), [&](int r) { return r <= y_in; }));
+        const int oracle =
+            static_cast<int>(std::count_if(ready.begin(), ready.end(), [&](int r) { return r <= y_in; }));
         ASSERT_EQ(rows, oracle) << where << ": rows ready after input line " << y_in;
       }
       for (; shown < rows; ++shown) {
@@ -128,7 +129,9 @@ TEST(FixedStreamingLines, ReportedLatencyIsTheLongestRowDelay) {
       meta.parity = Parity::Full;
       const std::vector<int> full_ready = ready_after(meta, link);
       int full_delay = 0;
-      for (int y = 0; y < full.height; ++y) full_delay = std::max(full_delay, full_ready[static_cast<std::size_t>(y)] - y);
+      for (int y = 0; y < full.height; ++y) {
+        full_delay = std::max(full_delay, full_ready[static_cast<std::size_t>(y)] - y);
+      }
       EXPECT_EQ(report.full_latency_lines, full_delay) << "r=" << r << " " << full;
       meta.parity = Parity::Reduced;
       const std::vector<int> reduced_ready = ready_after(meta, link);

@@ -39,8 +39,10 @@ int c99_decode_views(const char* json, int32_t full_width, int32_t full_height, 
     s = trm_decoder_create(&config, &d);
   }
   if (s != TRM_OK) {
-    strncpy(message, trm_last_error(), message_capacity - 1);
-    message[message_capacity - 1] = '\0';
+    if (message_capacity > 0) {
+      strncpy(message, trm_last_error(), message_capacity - 1);
+      message[message_capacity - 1] = '\0';
+    }
     return (int)s;
   }
   for (v = 0; v < views && result == 0; ++v) {
