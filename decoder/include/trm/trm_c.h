@@ -116,7 +116,8 @@ typedef struct trm_decoder trm_decoder;
 
 /* The message of the last failed call of this thread that had no usable handle (create, null handle); "" if none. */
 const char* trm_last_error(void);
-/* The message of the last failed call on d ("" if none); with d NULL, trm_last_error(). */
+/* The message of the last call on d if it failed, else "" (a successful call clears it); with d NULL,
+ * trm_last_error(). */
 const char* trm_decoder_last_error(const trm_decoder* d);
 
 /* The C++ decoder's defaults (trm::FixedDecoderConfig{}): r = 0.5, sigma default, 8-bit sRGB link, encoded
