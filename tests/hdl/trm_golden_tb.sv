@@ -88,7 +88,8 @@ module trm_golden_tb;
 
   // Reads one `trm vectors` hex file into rows of words; returns its lines and words per line, and checks the file's
   // hash against the golden one.
-  task automatic read_vector_file(input string name, input logic [$clog2(MAX_FRAMES)-1:0] frame, input bit is_drive, output int lines,
+  task automatic read_vector_file(input string name, input logic [$clog2(MAX_FRAMES)-1:0] frame, input bit is_drive,
+                                  output int lines,
                                   output int samples);
     string path = {vectors_dir, "/", name};
     int fd;
@@ -229,13 +230,15 @@ module trm_golden_tb;
   logic [MAX_SAMPLES-1:0][15:0] model_out_drive, dut_out_drive;
 
   trm_decoder_model #(.MAX_SAMPLES(MAX_SAMPLES)) model (
-      .clk, .rst_n, .in_valid(model_in_valid), .in_ready(model_in_ready), .in_first, .in_kind, .in_eye, .in_index, .in_full_width,
+      .clk, .rst_n, .in_valid(model_in_valid), .in_ready(model_in_ready), .in_first, .in_kind, .in_eye, .in_index,
+      .in_full_width,
       .in_full_height, .in_intact, .in_samples, .in_codes, .out_valid(model_out_valid), .out_ready(1'b1),
       .out_row(model_out_row), .out_last(model_out_last), .out_samples(model_out_samples),
       .out_drive(model_out_drive));
 
   `TRM_DUT #(.MAX_SAMPLES(MAX_SAMPLES)) dut (
-      .clk, .rst_n, .in_valid(dut_in_valid), .in_ready(dut_in_ready), .in_first, .in_kind, .in_eye, .in_index, .in_full_width,
+      .clk, .rst_n, .in_valid(dut_in_valid), .in_ready(dut_in_ready), .in_first, .in_kind, .in_eye, .in_index,
+      .in_full_width,
       .in_full_height, .in_intact, .in_samples, .in_codes, .out_valid(dut_out_valid), .out_ready(dut_out_ready),
       .out_row(dut_out_row), .out_last(dut_out_last), .out_samples(dut_out_samples), .out_drive(dut_out_drive));
 
@@ -259,7 +262,8 @@ module trm_golden_tb;
     int differ = 0;
     for (int i = 0; i < drive_samples[v]; i++) if (dut_rows[v][y][i] != model_rows[v][y][i]) differ++;
     if (differ != 0) begin
-      $display("trm_golden_tb: ERROR: scoreboard: view %0d row %0d: the DUT differs from the model in %0d of %0d samples", v, y, differ,
+      $display("trm_golden_tb: ERROR: view %0d row %0d: the DUT differs from the model in %0d of %0d samples",
+               v, y, differ,
              drive_samples[v]);
       dut_mismatches++;
     end
@@ -278,7 +282,8 @@ module trm_golden_tb;
       for (int i = 0; i < drive_samples[v]; i++) begin
         if (model_out_drive[i] != expected[v][y][i]) begin
           if (code_mismatches < 10)
-            $display("trm_golden_tb: ERROR: model: view %0d row %0d sample %0d: drive code %0d, the vector file has %0d", v, y, i,
+            $display("trm_golden_tb: ERROR: view %0d row %0d sample %0d: model drive code %0d, vector file %0d",
+                     v, y, i,
                    model_out_drive[i], expected[v][y][i]);
           code_mismatches++;
         end
@@ -337,7 +342,7 @@ module trm_golden_tb;
         $fatal(1, "%0d model rows checked, %0d DUT rows compared, %0d expected", rows_checked, dut_rows_compared,
                rows_expected);
       if (code_mismatches != 0 || hash_mismatches != 0 || dut_mismatches != 0)
-        $fatal(1, "FAIL: %0d drive codes differ from the vector files, %0d views from their golden hash, %0d DUT rows from the model",
+        $fatal(1, "FAIL: %0d codes differ from the vectors, %0d views from their golden hash, %0d DUT rows from the model",
                code_mismatches, hash_mismatches, dut_mismatches);
       $display("trm_golden_tb: PASS %s %s: %0d views, %0d rows, every drive code and golden hash identical; DUT slot",
                scene, panel, frames, rows_checked);

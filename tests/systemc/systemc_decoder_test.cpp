@@ -212,7 +212,8 @@ int run_golden(const std::string& dir, const std::string& golden_path, const std
     for (std::size_t y = 0; y < got.size(); ++y) {
       if (got[y].row != static_cast<int>(y)) fail(view.name + ": row " + std::to_string(got[y].row) + " came as row " +
                                                   std::to_string(y) + " (raster order)");
-      if (got[y].samples != view.drive.rows[y]) fail(view.name + ": row " + std::to_string(y) + " differs from the CLI's");
+      if (got[y].samples != view.drive.rows[y])
+        fail(view.name + ": row " + std::to_string(y) + " differs from the CLI's");
       // The module's throughput: rows of a view leave at least clocks_per_row clocks apart.
       if (y > 0 && harness.times[v][y] - harness.times[v][y - 1] <
                        sc_core::sc_time(kClockNs * clocks_per_row, sc_core::SC_NS))
@@ -297,7 +298,8 @@ int run_bad_line(const std::string& dir) {
 int sc_main(int argc, char* argv[]) {
   try {
     const std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.size() == 6 && args[0] == "golden") return run_golden(args[1], args[2], args[3], args[4], std::stoi(args[5]));
+    if (args.size() == 6 && args[0] == "golden")
+      return run_golden(args[1], args[2], args[3], args[4], std::stoi(args[5]));
     if (args.size() == 2 && args[0] == "bad-config") return run_bad_config(args[1]);
     if (args.size() == 2 && args[0] == "bad-line") return run_bad_line(args[1]);
     std::cerr << "usage: systemc_decoder_test golden VECTORS_DIR GOLDEN_FILE SCENE PANEL CLOCKS_PER_ROW\n"
