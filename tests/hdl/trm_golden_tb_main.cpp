@@ -14,7 +14,8 @@
 
 // Replaces Verilator's (VL_USER_STOP is defined for this target).
 void vl_stop(const char* filename, int linenum, const char* hier) {
-  VL_PRINTF("%%Error: %s:%d: simulation stopped in %s\n", filename ? filename : "?", linenum, hier ? hier : "?");
+  VL_PRINTF("%%Error: %s:%d: simulation stopped%s%s\n", filename ? filename : "?", linenum,
+            hier && *hier ? " in " : "", hier && *hier ? hier : "");
   Verilated::runFlushCallbacks();
   std::exit(1);
 }
