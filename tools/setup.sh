@@ -14,7 +14,7 @@ packages=(
   libhidapi-dev            # HID rig feeder (hidraw + libusb backends)
   libgtest-dev libgmock-dev
   libbenchmark-dev         # Google Benchmark
-  libsystemc-dev           # sc_fixed: independent oracle for the fixed-point type
+  libsystemc-dev           # sc_fixed: independent oracle for the fixed-point type; the decoder as a SystemC module
   libcli11-dev             # command-line parsing
   nlohmann-json3-dev       # report.json
   zlib1g-dev               # CRC32 for link packets
@@ -26,6 +26,7 @@ packages=(
   clang libclang-rt-14-dev # libFuzzer for the link receiver
   python3-dev pybind11-dev python3-pybind11  # the Python module `trm` (tools/python), built for /usr/bin/python3
   python3-numpy python3-pytest               # its arrays and its test suite (tests/python)
+  verilator                # the decoder as a DPI-C golden model in an HDL simulation (tests/hdl)
 )
 
 missing=()
