@@ -15,5 +15,6 @@ void register_sweep(CLI::App& app, Action& action);
 void register_methods(CLI::App& app, Action& action);
 void register_compare(CLI::App& app, Action& action);
 void register_bench(CLI::App& app, Action& action);
+void register_calibrate(CLI::App& app, Action& action);
 
 }  // namespace trm::cli
