@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
@@ -54,7 +55,7 @@ std::string number_text(double value) {
 std::string accepted_forms() {
   const std::string gammas = "within [" + number_text(kMinPanelGamma) + ", " + number_text(kMaxPanelGamma) + "]";
   return "accepted panel specs: 'vive', 'rift', 'generic', 'gamma:G', 'gamma:GR,GG,GB' (gammas " + gammas +
-         "), 'lcd', 'lcd:p1,p2,p3,p4,gamma' (finite parameters within [-" + number_text(kMaxLcdCoefficient) + ", " +
+         "), 'lcd', 'lcd:FILE.json' (a panel preset, as trm calibrate writes it), 'lcd:p1,p2,p3,p4,gamma' (finite parameters within [-" + number_text(kMaxLcdCoefficient) + ", " +
          number_text(kMaxLcdCoefficient) + "], M increasing in the drive, gamma " + gammas + ")";
 }
 
@@ -335,10 +336,35 @@ bool parse_oled_spec(const std::string& spec, Panel& out) {
   return true;
 }
 
-// The LCD forms: lcd (the default merge) | lcd:p1,p2,p3,p4,gamma. False when `spec` is neither.
+// lcd:FILE.json: the panel JSON of to_json (what `trm calibrate` writes), which must be an LCD.
+Panel read_lcd_preset(const std::string& spec, const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) reject(spec, "cannot open the preset file " + in_quotes(path));
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    reject(spec, "the preset file " + in_quotes(path) + " is not JSON (" + e.what() + ")");
+  }
+  Panel panel;
+  try {
+    from_json(json, panel);
+  } catch (const std::invalid_argument& e) {
+    reject(spec, "the preset file " + in_quotes(path) + ": " + e.what());
+  }
+  if (panel.kind != PanelKind::Lcd) reject(spec, "the preset file " + in_quotes(path) + " is not an LCD panel");
+  return panel;
+}
+
+// The LCD forms: lcd (the default merge) | lcd:FILE.json | lcd:p1,p2,p3,p4,gamma. False when `spec` is none.
 bool parse_lcd_spec(const std::string& spec, Panel& out) {
   const std::string_view view(spec);
   if (spec != "lcd" && !view.starts_with("lcd:")) return false;
+  // A list of numbers never ends in ".json": the suffix alone tells a preset file from parameters.
+  if (view.ends_with(".json")) {
+    out = read_lcd_preset(spec, spec.substr(4));
+    return true;
+  }
   out = Panel();
   out.kind = PanelKind::Lcd;
   out.name = spec;

@@ -1,4 +1,5 @@
-// Panel light over a frame: emission window times the first-order liquid-crystal state, in closed form.
+// Panel light over a frame: emission window times the liquid-crystal state (constant or level-dependent τ), in
+// closed form.
 #include "trm/panel_light.hpp"
 
 #include <algorithm>
@@ -47,7 +48,11 @@ PanelLight::PanelLight(const PanelLightConfig& config) : config_(config) {
   if (!(std::isfinite(config.lc_tau_s) && config.lc_tau_s >= 0.0)) {
     reject(kWhere, "lc_tau_s", "must be finite and >= 0, got " + number_text(config.lc_tau_s));
   }
+  if (config.lc_response && config.lc_tau_s != 0.0) {
+    reject(kWhere, "lc_tau_s", "must be 0 when lc_response is set (one LC model), got " + number_text(config.lc_tau_s));
+  }
   period_ = 1.0 / config.refresh_hz;
+  if (config.lc_response) response_.emplace(*config.lc_response, period_);
   window_begin_ = config.window_start * period_;
   window_end_ = std::min(period_, (config.window_start + config.duty) * period_);
   decay_ = config.lc_tau_s > 0.0 ? std::exp(-period_ / config.lc_tau_s) : 0.0;
@@ -61,22 +66,29 @@ double PanelLight::row_delay_s(int y, int rows) const {
   return config_.scan_out == ScanOut::Rolling ? period_ * y / rows : 0.0;
 }
 
+LcSegment PanelLight::segment(double previous_state, double level) const {
+  if (response_) return response_->segment(previous_state, level);
+  return {level, config_.lc_tau_s};
+}
+
 double PanelLight::level_at(double t, double previous_state, double level) const {
   if (!(t >= window_begin_ && t < window_end_)) return 0.0;
-  const double tau = config_.lc_tau_s;
-  const double state = tau > 0.0 ? level + (previous_state - level) * std::exp(-t / tau) : level;
+  const LcSegment seg = segment(previous_state, level);
+  const double state = seg.tau_s > 0.0 ? seg.drive + (previous_state - seg.drive) * std::exp(-t / seg.tau_s) : seg.drive;
   return state / config_.duty;
 }
 
-LightWeights PanelLight::weights(double t0, double t1) const {
+LightWeights PanelLight::weights(double t0, double t1) const { return weights(t0, t1, config_.lc_tau_s); }
+
+LightWeights PanelLight::weights(double t0, double t1, double tau) const {
   constexpr const char* kWhere = "PanelLight::weights";
   if (!(t0 >= 0.0 && t0 <= period_)) reject(kWhere, "t0", "must be in [0, T], got " + number_text(t0));
   if (!(t1 >= t0 && t1 <= period_)) reject(kWhere, "t1", "must be in [t0, T], got " + number_text(t1));
+  if (!(tau >= 0.0)) reject(kWhere, "tau_s", "must be >= 0, got " + number_text(tau));
   const double u0 = std::max(t0, window_begin_);
   const double u1 = std::min(t1, window_end_);
   if (!(u1 > u0)) return {};
   const double span = u1 - u0;
-  const double tau = config_.lc_tau_s;
   const double duty = config_.duty;
   if (tau == 0.0) return {span / duty, 0.0};
   // ∫ s = L Δ + (s0 − L) τ e^{−u0/τ} (1 − e^{−Δ/τ}); the level part regrouped as
@@ -89,11 +101,13 @@ LightWeights PanelLight::weights(double t0, double t1) const {
 }
 
 double PanelLight::integral(double t0, double t1, double previous_state, double level) const {
-  const LightWeights w = weights(t0, t1);
-  return w.level * level + w.previous * previous_state;
+  const LcSegment seg = segment(previous_state, level);
+  const LightWeights w = weights(t0, t1, seg.tau_s);
+  return w.level * seg.drive + w.previous * previous_state;
 }
 
 double PanelLight::end_state(double previous_state, double level) const {
+  if (response_) return response_->advance(previous_state, response_->drive_for(previous_state, level), period_);
   return level + (previous_state - level) * decay_;
 }
 
@@ -112,7 +126,8 @@ PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOp
       reject("panel_light", "strobe_duty", "must be in (0, 1], got " + number_text(options.strobe_duty));
     }
     config.window_start = options.strobe_start < 0.0 ? 1.0 - options.strobe_duty : options.strobe_start;
-    config.lc_tau_s = options.lc_tau_s;
+    config.lc_tau_s = 0.0;
+    config.lc_response = options.lc_response;
   }
   return PanelLight(config);
 }

@@ -144,18 +144,32 @@ void line_pass(const std::vector<const double*>& frames, Line line, const double
   const auto frame_count = static_cast<int>(frames.size());
   const std::size_t samples = static_cast<std::size_t>(line.n) * line.c;
   std::vector<double> state(previous ? previous : frames[0], (previous ? previous : frames[0]) + samples);
-  const bool has_history = light.config().lc_tau_s > 0.0;
+  const bool has_history = light.has_lc_state();
+  // The level-dependent response gives every pixel its own segment (drive, τ): its light over a step is summed per
+  // pixel first, then shifted once.
+  const bool per_pixel = light.lc_response().has_value();
+  std::vector<LcSegment> segments(per_pixel ? samples : 0);
+  std::vector<double> step_light(per_pixel ? samples : 0);
   const double begin = steps == Steps::Lit ? light.window_begin_s() : 0.0;
   const double end = steps == Steps::Lit ? light.window_end_s() : period;
   for (int f = 0; f < frame_count; ++f) {
+    for (std::size_t i = 0; i < segments.size(); ++i) segments[i] = light.segment(state[i], frames[f][i]);
     for (int k = 0; k < substeps; ++k) {
       const double t0 = begin + (end - begin) * k / substeps;
       const double t1 = k + 1 == substeps ? end : begin + (end - begin) * (k + 1) / substeps;
-      const LightWeights w = light.weights(t0, t1);
       const double middle = delay_s + f * period + (t0 + t1) / 2.0;
       const double shift = velocity_px_s * (middle - origin_s);
       double* dst = steps == Steps::Lit ? out_rows[0] : out_rows[static_cast<std::size_t>(f) * substeps + k];
       const double scale = steps == Steps::Lit ? 1.0 / (frame_count * period) : 1.0 / (t1 - t0);
+      if (per_pixel) {
+        for (std::size_t i = 0; i < samples; ++i) {
+          const LightWeights w = light.weights(t0, t1, segments[i].tau_s);
+          step_light[i] = w.level * segments[i].drive + w.previous * state[i];
+        }
+        add_shifted(step_light.data(), line, shift, scale, dst);
+        continue;
+      }
+      const LightWeights w = light.weights(t0, t1);
       add_shifted(frames[f], line, shift, w.level * scale, dst);
       if (has_history) add_shifted(state.data(), line, shift, w.previous * scale, dst);
     }

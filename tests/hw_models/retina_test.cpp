@@ -89,7 +89,10 @@ TEST(PanelLight, OledPresetsUseTheirDuty) {
   EXPECT_NEAR(vive.window_end_s() * 1e3, 2.222, 1e-3);  // ms of an 11.1 ms frame
   const PanelLight lcd = panel_light(parse_panel("lcd"), 120.0);
   EXPECT_EQ(lcd.config().duty, 1.0);
-  EXPECT_EQ(lcd.config().lc_tau_s, kDefaultLcdTauS);
+  // LCD panels take the level-dependent response with its defaults, not a constant τ.
+  EXPECT_EQ(lcd.config().lc_tau_s, 0.0);
+  ASSERT_TRUE(lcd.lc_response().has_value());
+  EXPECT_EQ(lcd.lc_response()->params().tau_off_s, LcResponseParams{}.tau_off_s);
 }
 
 TEST(PanelLight, RollingScanOutDelaysEachRowByItsShareOfTheFrame) {
@@ -220,7 +223,7 @@ TEST(HoldTypeBlur, StrobedBacklightBlursByTheStrobeAndTheCrystalAddsItsResponse)
   options.substeps = 512;
   PanelLightOptions strobe;
   strobe.strobe_duty = 0.25;
-  strobe.lc_tau_s = 1e-9;
+  strobe.lc_response.tau_off_s = 1e-9;
   const cv::Mat strobed = retinal_row(edge.frames, panel_light(parse_panel("lcd"), EdgeCase::kRefresh, strobe),
                                       edge.viewer, edge.speed_deg_s, options);
   EXPECT_NEAR(edge_width_px(strobed), 0.8 * 0.25 * 40.0, 0.01);
@@ -488,8 +491,8 @@ TEST(BadInput, ThrowsNamingTheArgument) {
   strobe.strobe_duty = 0.0;
   expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, strobe); }, "strobe_duty");
   PanelLightOptions tau;
-  tau.lc_tau_s = -1.0;
-  expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, tau); }, "lc_tau_s");
+  tau.lc_response.tau_off_s = -1.0;
+  expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, tau); }, "tau_off_s");
 
   const cv::Mat frames(2, 8, CV_64FC1, cv::Scalar(0.5));
   const PanelLight light = hold_light(90.0);

@@ -32,6 +32,7 @@ int run_main(int argc, char** argv) {
   register_compare(app, action);
   register_bench(app, action);
   register_analyze(app, action);
+  register_calibrate(app, action);
 
   // Every failure, of parsing or of the run, is one "trm: error:" line on stderr and a non-zero exit.
   const auto usage_hint = [&app] {

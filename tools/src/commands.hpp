@@ -16,5 +16,6 @@ void register_methods(CLI::App& app, Action& action);
 void register_compare(CLI::App& app, Action& action);
 void register_bench(CLI::App& app, Action& action);
 void register_analyze(CLI::App& app, Action& action);
+void register_calibrate(CLI::App& app, Action& action);
 
 }  // namespace trm::cli

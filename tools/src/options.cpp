@@ -179,7 +179,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_option("--sensitivity,-s", sensitivity, "Motion sensitivity s in w = exp(-s c)")->capture_default_str();
   cmd.add_option_function<std::string>(
          "--panel", [this](const std::string& spec) { panel = parse_panel(spec); },
-         "vive | rift | generic | gamma:G | gamma:GR,GG,GB | lcd | lcd:p1,p2,p3,p4,gamma")
+         "vive | rift | generic | gamma:G | gamma:GR,GG,GB | lcd | lcd:p1,p2,p3,p4,gamma | "
+         "lcd:FILE.json (a preset of trm calibrate)")
       ->default_str(panel.name);
   cmd.add_option_function<std::string>(
       "--lcd-history",

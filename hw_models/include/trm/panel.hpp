@@ -136,9 +136,10 @@ inline constexpr double kMaxLcdCoefficient = 16.0;
 // std::invalid_argument with `what` and the rule.
 void validate_panel(const Panel& panel, const std::string& what);
 
-// "vive" | "rift" | "generic" | "gamma:G" | "gamma:GR,GG,GB" | "lcd" | "lcd:p1,p2,p3,p4,gamma".
-// Throws std::invalid_argument with the list of accepted forms, for a malformed spec and for a panel that breaks
-// validate_panel's rules.
+// "vive" | "rift" | "generic" | "gamma:G" | "gamma:GR,GG,GB" | "lcd" | "lcd:p1,p2,p3,p4,gamma" | "lcd:FILE.json"
+// (an LCD panel's JSON as to_json writes it, e.g. the preset of `trm calibrate`). Throws std::invalid_argument with
+// the list of accepted forms, for a malformed spec, an unreadable or malformed preset file and for a panel that
+// breaks validate_panel's rules.
 Panel parse_panel(const std::string& spec);
 
 // The panel as JSON, every parameter of its kind: {"kind": "oled", "name", "gamma": [R, G, B], "duty"} or

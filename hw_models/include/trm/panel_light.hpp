@@ -18,14 +18,19 @@
 // losses (BFI, interlace) come from their black frames and rows, which are levels 0 through the same model.
 //
 // The liquid crystal relaxes toward L for the whole frame, lit or not, and a frame ends at end_state(s0, L), where
-// the next frame starts. Every value is the closed form (the exponential update, not a time step of the ODE), so it
+// the next frame starts. τ is either one constant (lc_tau_s) or, for LCD panels, the level-dependent response of
+// lc_response.hpp (rise τ_on(p) faster at higher drive, fall τ_off, optional overdrive): then each frame's segment
+// relaxes toward the drive p the panel applies (L, or the overdriven level) with τ(s0, p), per pixel. Every value is the closed form (the exponential update, not a time step of the ODE), so it
 // is exact and stable for any τ >= 0: τ far below T reaches L without overshoot, τ far above T barely moves.
 //
 // Rolling scan-out: row y of H starts its frames y / H · T after row 0 (the scan reaches it then); global scan-out
 // starts every row together. Times passed to level_at and integral are since the row's own frame start.
 #pragma once
 
+#include "trm/lc_response.hpp"
 #include "trm/panel.hpp"
+
+#include <optional>
 
 #include <string>
 
@@ -39,6 +44,8 @@ struct PanelLightConfig {
   double window_start = 0.0;  // start of the window as a fraction of the frame, in [0, 1 − duty]
   double lc_tau_s = 0.0;      // τ of the liquid-crystal response, >= 0 s; 0: instant (OLED)
   ScanOut scan_out = ScanOut::Global;
+  // The level-dependent LC response; set, it replaces lc_tau_s (which must then be 0).
+  std::optional<LcResponseParams> lc_response = std::nullopt;
 };
 
 // Low persistence on the Vive (paper Sec. 2.2, Fig. 2c, measured with a 9 kHz sensor: "the display remains black for
@@ -48,15 +55,14 @@ struct PanelLightConfig {
 // (panel.hpp uses it for every OLED preset; no per-model measurement of the Rift CV1 was found).
 inline constexpr double kViveOledDuty = 0.2;
 
-// Default τ of the LCD's first-order response. A first-order step reaches 90 % from 10 % in τ ln 9 ≈ 2.2 τ, so 2 ms
-// is a 4.4 ms transition, the order of the 4 ms grey-to-grey rating of fast IPS gaming monitors such as the paper's
-// ASUS ROG Swift (Sec. 4.4; a rating, not a measurement of its curve). A placeholder until the level-dependent LC ODE.
+// The constant τ of a first-order response with one time constant for every transition: 2 ms, the falling τ_off of
+// LcResponseParams. LCD panels use the level-dependent response (PanelLightOptions::lc_response) instead.
 inline constexpr double kDefaultLcdTauS = 0.002;
 
 // Options for the light of a Panel (panel_light): what the drive model does not know.
 struct PanelLightOptions {
   ScanOut scan_out = ScanOut::Global;
-  double lc_tau_s = kDefaultLcdTauS;  // LCD only
+  LcResponseParams lc_response;       // LCD only: the level-dependent LC response
   double strobe_duty = 1.0;           // LCD only: backlight window (1: always on)
   // LCD only: strobe window start as a fraction of the frame; negative means at the end of the frame (1 − duty),
   // where the liquid crystal has settled most, as strobed backlights place it.
@@ -72,7 +78,7 @@ struct LightWeights {
 class PanelLight {
  public:
   // Throws std::invalid_argument naming the field: refresh_hz finite and > 0, duty in (0, 1], window_start in
-  // [0, 1 − duty], lc_tau_s finite and >= 0.
+  // [0, 1 − duty], lc_tau_s finite and >= 0 (0 with lc_response), lc_response's fields (LcResponse).
   explicit PanelLight(const PanelLightConfig& config);
 
   const PanelLightConfig& config() const { return config_; }
@@ -83,13 +89,22 @@ class PanelLight {
   // When row y of `rows` starts its frames after row 0: y / rows · T for rolling scan-out, 0 for global. Throws
   // std::invalid_argument naming `rows` (< 1) or `y` (outside [0, rows)).
   double row_delay_s(int y, int rows) const;
+  // The LC response: its state depends on the previous frame (lc_tau_s > 0 or lc_response), and whether its τ
+  // depends on the transition (lc_response: the weights differ per pixel, take them from segment()).
+  bool has_lc_state() const { return config_.lc_tau_s > 0.0 || response_.has_value(); }
+  const std::optional<LcResponse>& lc_response() const { return response_; }
+  // The frame's segment from state s0 for wanted level L: the drive the LC relaxes toward and τ (constant τ: L, τ).
+  LcSegment segment(double previous_state, double level) const;
 
-  // light(t) for t in [0, T] since the frame start, after state s0 (`previous_state`), driving `level`.
+  // light(t) for t in [0, T] since the frame start, after state s0 (`previous_state`), driving `level` (through
+  // segment(): with overdrive the LC relaxes toward the overdriven level).
   double level_at(double t, double previous_state, double level) const;
   // ∫_{t0}^{t1} light dt in closed form, 0 <= t0 <= t1 <= T (throws std::invalid_argument naming `t0` or `t1`):
   // previous = τ e^{−u0/τ} (1 − e^{−Δ/τ}) / duty and level = Δ / duty − previous over the lit part [u0, u0 + Δ] of
   // [t0, t1], each evaluated without cancellation (expm1 and a series for Δ ≪ τ), to a few ulps.
+  // With the constant τ; the second form for one segment's τ (tau_s >= 0).
   LightWeights weights(double t0, double t1) const;
+  LightWeights weights(double t0, double t1, double tau_s) const;
   double integral(double t0, double t1, double previous_state, double level) const;
   // s(T): the state the frame leaves for the next one (the level itself when τ = 0).
   double end_state(double previous_state, double level) const;
@@ -100,10 +115,12 @@ class PanelLight {
   double window_begin_ = 0.0;
   double window_end_ = 0.0;
   double decay_ = 0.0;  // e^{−T/τ}
+  std::optional<LcResponse> response_;
 };
 
 // The light of `panel` at `refresh_hz`: an OLED emits for panel.oled.duty of the frame from its start with no LC
-// response; an LCD holds (or strobes) with τ = options.lc_tau_s. Throws std::invalid_argument naming the argument.
+// response; an LCD holds (or strobes) with the level-dependent LC response options.lc_response. Throws
+// std::invalid_argument naming the argument.
 PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOptions& options = {});
 
 // The steady level drive v holds on `panel` (channel c): OLED v^gamma_c, LCD M(v, v)^gamma. What a frame's drive

@@ -1,0 +1,247 @@
+// The level-dependent liquid-crystal response (lc_response.hpp) and its use by PanelLight and the retina.
+#include <gtest/gtest.h>
+
+#include "trm/lc_response.hpp"
+#include "trm/panel.hpp"
+#include "trm/panel_light.hpp"
+#include "trm/retina.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace trm {
+namespace {
+
+constexpr double kRefresh = 120.0;
+constexpr double kPeriod = 1.0 / kRefresh;
+
+// τ_on from the Jakeman–Raynes form, written out again here rather than taken from the model.
+double jakeman_raynes_rise_tau(const LcResponseParams& p, double level) {
+  const double v_over_vth = 1.0 + (p.drive_ratio - 1.0) * std::pow(level, 1.0 / p.drive_gamma);
+  return p.tau_off_s / (v_over_vth * v_over_vth - 1.0);
+}
+
+PanelLight lc_light(const LcResponseParams& params, double refresh_hz = kRefresh) {
+  PanelLightConfig config;
+  config.refresh_hz = refresh_hz;
+  config.lc_response = params;
+  return PanelLight(config);
+}
+
+// The ODE's right-hand side with τ chosen per segment by the sign of the step, as the model defines it.
+double rhs(const LcResponseParams& p, double x0, double drive, double x) {
+  const double tau = drive > x0 ? jakeman_raynes_rise_tau(p, drive) : p.tau_off_s;
+  return (drive - x) / tau;
+}
+
+// Classical Runge–Kutta over one frame of constant drive in n steps: the independent fine-step reference.
+double rk4_frame(const LcResponseParams& p, double x0, double drive, int n) {
+  const double h = kPeriod / n;
+  double x = x0;
+  for (int i = 0; i < n; ++i) {
+    const double k1 = rhs(p, x0, drive, x);
+    const double k2 = rhs(p, x0, drive, x + h / 2 * k1);
+    const double k3 = rhs(p, x0, drive, x + h / 2 * k2);
+    const double k4 = rhs(p, x0, drive, x + h * k3);
+    x += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  return x;
+}
+
+// The foil: explicit Euler of the same ODE with step h.
+double euler_frame(const LcResponseParams& p, double x0, double drive, double h, int steps) {
+  double x = x0;
+  for (int i = 0; i < steps; ++i) x += h * rhs(p, x0, drive, x);
+  return x;
+}
+
+void expect_invalid(const std::function<void()>& make, const std::string& needle) {
+  try {
+    make();
+    ADD_FAILURE() << "no exception, expected one naming " << needle;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(LcResponse, RisingAndFallingTransitionsAreTheirClosedForms) {
+  const LcResponseParams params;
+  const PanelLight light = lc_light(params);
+  for (const auto& [x0, level] : {std::pair{0.1, 0.8}, std::pair{0.0, 0.05}, std::pair{0.9, 0.2}, std::pair{1.0, 0.0}}) {
+    const double tau = level > x0 ? jakeman_raynes_rise_tau(params, level) : params.tau_off_s;
+    const auto exact = [&](double t) { return level + (x0 - level) * std::exp(-t / tau); };
+    EXPECT_NEAR(light.end_state(x0, level), exact(kPeriod), 1e-15) << x0 << " -> " << level;
+    EXPECT_NEAR(light.level_at(0.003, x0, level), exact(0.003), 1e-15);
+    const double integral = level * kPeriod + (x0 - level) * tau * (1.0 - std::exp(-kPeriod / tau));
+    EXPECT_NEAR(light.integral(0.0, kPeriod, x0, level), integral, 1e-15 * kPeriod);
+  }
+  // Falling does not depend on the level: the elastic constant alone sets it.
+  const LcResponse lc(params, kPeriod);
+  EXPECT_EQ(lc.tau_s(0.9, 0.1), params.tau_off_s);
+  EXPECT_EQ(lc.tau_s(0.5, 0.0), params.tau_off_s);
+}
+
+TEST(LcResponse, FineStepReferenceConvergesToTheExactUpdate) {
+  const LcResponseParams params;
+  const PanelLight light = lc_light(params);
+  const std::vector<double> levels{0.02, 0.7, 0.3, 1.0, 0.0, 0.45};
+  double errors[3] = {};
+  const int steps[3] = {20, 40, 2000};
+  for (int s = 0; s < 3; ++s) {
+    double exact = 0.0, reference = 0.0;
+    for (double level : levels) {
+      // Each frame starts both from the exact state so that only this frame's error is measured.
+      reference = rk4_frame(params, exact, level, steps[s]);
+      exact = light.end_state(exact, level);
+      errors[s] = std::max(errors[s], std::abs(reference - exact));
+    }
+  }
+  // RK4 is fourth order: doubling the steps divides the error by about 16; at T/2000 it agrees to rounding.
+  EXPECT_GT(errors[0] / errors[1], 12.0) << errors[0] << " " << errors[1];
+  EXPECT_LT(errors[2], 1e-13);
+}
+
+TEST(LcResponse, StiffCrystalReachesTheLevelWhereExplicitEulerBlowsUp) {
+  LcResponseParams params;
+  params.tau_off_s = 1e-9;
+  const PanelLight light = lc_light(params, 90.0);
+  const double period = 1.0 / 90.0;
+  const double h = period / kDefaultRetinaSubsteps;  // the retina's sub-step
+  for (const auto& [x0, level] : {std::pair{0.0, 1.0}, std::pair{1.0, 0.25}, std::pair{0.1, 0.6}}) {
+    EXPECT_EQ(light.end_state(x0, level), level);
+    for (int i = 0; i < 64; ++i) {
+      const double value = light.level_at(period * i / 64.0, x0, level);
+      ASSERT_TRUE(std::isfinite(value));
+      // No overshoot (1e-16: the rounding of p + (x0 − p) at t = 0).
+      EXPECT_GE(value, std::min(x0, level) - 1e-16);
+      EXPECT_LE(value, std::max(x0, level) + 1e-16);
+    }
+    const double euler = euler_frame(params, x0, level, h, kDefaultRetinaSubsteps);
+    EXPECT_FALSE(std::isfinite(euler) && std::abs(euler - level) < 1.0) << euler;
+  }
+  // The eye model on it: an instant panel, finite everywhere.
+  cv::Mat frames(4, 32, CV_64F);
+  for (int f = 0; f < frames.rows; ++f) {
+    for (int x = 0; x < frames.cols; ++x) frames.at<double>(f, x) = ((x + 3 * f) % 8) < 4 ? 1.0 : 0.02;
+  }
+  const Viewer viewer = custom_viewer(20.0);
+  const cv::Mat stiff = retinal_row(frames, light, viewer, 30.0);
+  const cv::Mat instant = retinal_row(frames, PanelLight(PanelLightConfig{90.0, 1.0, 0.0, 0.0}), viewer, 30.0);
+  EXPECT_TRUE(cv::checkRange(stiff));
+  EXPECT_LT(cv::norm(stiff, instant, cv::NORM_INF), 1e-6);
+}
+
+TEST(LcResponse, RiseIsFasterAtHigherDrive) {
+  const LcResponseParams params;
+  const LcResponse lc(params, kPeriod);
+  double previous_tau = std::numeric_limits<double>::infinity();
+  double previous_fraction = 0.0;
+  for (double level = 0.05; level <= 1.0; level += 0.05) {
+    const double tau = lc.rise_tau_s(level);
+    EXPECT_LT(tau, previous_tau) << level;
+    EXPECT_NEAR(tau, jakeman_raynes_rise_tau(params, level), 1e-15);
+    // The share of the step from black reached after 1 ms grows with the drive.
+    const double fraction = lc.advance(0.0, level, 0.001) / level;
+    EXPECT_GT(fraction, previous_fraction) << level;
+    previous_tau = tau;
+    previous_fraction = fraction;
+  }
+  // Full drive rises τ_off / ((V_max/V_th)² − 1), well before the elastic fall.
+  EXPECT_NEAR(lc.rise_tau_s(1.0), params.tau_off_s / 8.0, 1e-18);
+  EXPECT_LT(lc.rise_tau_s(1.0), params.tau_off_s);
+}
+
+TEST(LcResponse, OverdriveReachesTheTargetWithinOneFrameWhereTheLutCan) {
+  LcResponseParams plain;
+  plain.tau_off_s = 0.006;  // slow enough that plain drive misses most grey targets within a 120 Hz frame
+  LcResponseParams overdriven = plain;
+  overdriven.overdrive_grid = 17;
+  const PanelLight without = lc_light(plain);
+  const PanelLight with = lc_light(overdriven);
+  const LcResponse& lc = *with.lc_response();
+  int designed = 0;
+  double plain_worst = 0.0, on_node_worst = 0.0, between_worst = 0.0;
+  for (int i = 0; i <= 16; ++i) {
+    for (int j = 0; j <= 16; ++j) {
+      const double x0 = i / 16.0, level = j / 16.0;
+      const double drive = lc.exact_overdrive(x0, level);
+      if (drive <= 0.0 || drive >= 1.0) continue;  // clamped: the drive range cannot reach it in a frame
+      ++designed;
+      on_node_worst = std::max(on_node_worst, std::abs(with.end_state(x0, level) - level));
+      plain_worst = std::max(plain_worst, std::abs(without.end_state(x0, level) - level));
+      // Half-way between nodes the bilinear LUT is close, not exact.
+      const double xm = std::min(1.0, x0 + 1.0 / 32), lm = std::min(1.0, level + 1.0 / 32);
+      const double dm = lc.exact_overdrive(xm, lm);
+      if (dm > 0.0 && dm < 1.0) between_worst = std::max(between_worst, std::abs(with.end_state(xm, lm) - lm));
+    }
+  }
+  EXPECT_GT(designed, 100);
+  EXPECT_LT(on_node_worst, 1e-12);
+  EXPECT_LT(between_worst, 0.02) << between_worst;
+  EXPECT_GT(plain_worst, 0.1);  // without overdrive the same transitions miss by far more
+  // Where the target is out of reach the LUT drives the full range: black to white at full drive, no further.
+  EXPECT_EQ(lc.drive_for(0.0, 1.0), 1.0);
+  EXPECT_EQ(with.end_state(0.0, 1.0), without.end_state(0.0, 1.0));
+}
+
+TEST(LcResponse, StateIsMonotoneInTimeLevelAndStartWithoutOvershoot) {
+  LcResponseParams params;
+  params.overdrive_grid = 33;
+  for (const PanelLight& light : {lc_light(LcResponseParams{}), lc_light(params)}) {
+    for (const auto& [x0, level] : {std::pair{0.0, 0.5}, std::pair{0.8, 0.1}, std::pair{0.3, 0.31}}) {
+      const double drive = light.segment(x0, level).drive;
+      double last = x0;
+      for (int i = 1; i <= 100; ++i) {
+        const double value = light.level_at(kPeriod * i / 100.0 - 1e-12, x0, level);
+        if (level > x0) {
+          EXPECT_GE(value, last);
+          EXPECT_LE(value, drive);
+        } else {
+          EXPECT_LE(value, last);
+          EXPECT_GE(value, drive);
+        }
+        last = value;
+      }
+    }
+    for (double x0 : {0.0, 0.4, 1.0}) {
+      double last = -1.0;
+      for (int j = 0; j <= 64; ++j) {
+        const double end = light.end_state(x0, j / 64.0);
+        EXPECT_GE(end, last) << x0 << " " << j;
+        last = end;
+      }
+    }
+  }
+}
+
+TEST(LcResponse, BadParametersAreRejectedByName) {
+  const auto with = [](const std::function<void(LcResponseParams&)>& change) {
+    LcResponseParams p;
+    change(p);
+    return p;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  expect_invalid([&] { LcResponse(with([](auto& p) { p.tau_off_s = 0.0; }), kPeriod); }, "'tau_off_s'");
+  expect_invalid([&] { LcResponse(with([&](auto& p) { p.tau_off_s = nan; }), kPeriod); }, "'tau_off_s'");
+  expect_invalid([&] { LcResponse(with([](auto& p) { p.drive_ratio = 1.0; }), kPeriod); }, "'drive_ratio'");
+  expect_invalid([&] { LcResponse(with([](auto& p) { p.drive_gamma = 9.0; }), kPeriod); }, "'drive_gamma'");
+  expect_invalid([&] { LcResponse(with([](auto& p) { p.overdrive_grid = 1; }), kPeriod); }, "'overdrive_grid'");
+  expect_invalid([&] { LcResponse(with([](auto& p) { p.overdrive_grid = -4; }), kPeriod); }, "'overdrive_grid'");
+  expect_invalid([&] { LcResponse(LcResponseParams{}, 0.0); }, "'frame_period_s'");
+  PanelLightConfig both;
+  both.lc_tau_s = 0.002;
+  both.lc_response = LcResponseParams{};
+  expect_invalid([&] { PanelLight{both}; }, "'lc_tau_s'");
+  PanelLightOptions options;
+  options.lc_response.drive_ratio = nan;
+  expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, options); }, "'drive_ratio'");
+}
+
+}  // namespace
+}  // namespace trm
