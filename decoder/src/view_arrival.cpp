@@ -19,9 +19,10 @@ std::string frame_name(const FrameMeta& meta) {
          " eye=" + std::to_string(meta.eye);
 }
 
-void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who) {
-  const FrameMeta& meta = frame.meta;
-  const std::string what = who + ": " + frame_name(meta) + ": ";
+namespace {
+
+// The view's metadata against the decoder's link format; returns the size its codes must have.
+cv::Size check_header_format(const FrameMeta& meta, const EncoderConfig& link, const std::string& what) {
   check_view_meta(meta, what);
   if (meta.bits != link.bits) {
     throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
@@ -31,6 +32,24 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
     throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
                                 to_string(link.transfer));
   }
+  const cv::Size full(meta.full_width, meta.full_height);
+  return meta.parity == Parity::Full
+             ? full
+             : cv::Size(reduced_size(full.width, link.reduction), reduced_size(full.height, link.reduction));
+}
+
+// " but a <parity> frame of a WxH view at r=R must be wxh"
+std::string expected_size_text(const FrameMeta& meta, const EncoderConfig& link, cv::Size expected) {
+  return std::string(" but a ") + to_string(meta.parity) + " frame of a " + size_text(meta.full_width, meta.full_height) +
+         " view at r=" + std::to_string(link.reduction) + " must be " + size_text(expected.width, expected.height);
+}
+
+}  // namespace
+
+void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who) {
+  const FrameMeta& meta = frame.meta;
+  const std::string what = who + ": " + frame_name(meta) + ": ";
+  const cv::Size expected = check_header_format(meta, link, what);
   if (frame.codes.empty() || frame.codes.type() != CV_16UC3) {
     throw std::invalid_argument(what + "codes must be a non-empty CV_16UC3 image");
   }
@@ -41,16 +60,8 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
     throw std::invalid_argument(what + "codes are " + codes_size + " but the metadata says " +
                                 size_text(meta.width, meta.height));
   }
-  const cv::Size full(meta.full_width, meta.full_height);
-  const cv::Size expected = meta.parity == Parity::Full
-                                ? full
-                                : cv::Size(reduced_size(full.width, link.reduction),
-                                           reduced_size(full.height, link.reduction));
   if (frame.codes.size() != expected) {
-    throw std::invalid_argument(what + "codes are " + codes_size + " but a " + to_string(meta.parity) +
-                                " frame of a " + size_text(full.width, full.height) + " view at r=" +
-                                std::to_string(link.reduction) + " must be " +
-                                size_text(expected.width, expected.height));
+    throw std::invalid_argument(what + "codes are " + codes_size + expected_size_text(meta, link, expected));
   }
   double highest = 0.0;
   cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
@@ -62,25 +73,10 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
 
 void check_view_header(const FrameMeta& meta, const EncoderConfig& link, const std::string& who) {
   const std::string what = who + ": " + frame_name(meta) + ": ";
-  check_view_meta(meta, what);
-  if (meta.bits != link.bits) {
-    throw std::invalid_argument(what + "link bits " + std::to_string(meta.bits) + " but the decoder expects " +
-                                std::to_string(link.bits));
-  }
-  if (meta.transfer != link.transfer) {
-    throw std::invalid_argument(what + "transfer " + to_string(meta.transfer) + " but the decoder expects " +
-                                to_string(link.transfer));
-  }
-  const cv::Size full(meta.full_width, meta.full_height);
-  const cv::Size expected = meta.parity == Parity::Full
-                                ? full
-                                : cv::Size(reduced_size(full.width, link.reduction),
-                                           reduced_size(full.height, link.reduction));
+  const cv::Size expected = check_header_format(meta, link, what);
   if (cv::Size(meta.width, meta.height) != expected) {
-    throw std::invalid_argument(what + "the metadata says " + size_text(meta.width, meta.height) + " but a " +
-                                to_string(meta.parity) + " frame of a " + size_text(full.width, full.height) +
-                                " view at r=" + std::to_string(link.reduction) + " must be " +
-                                size_text(expected.width, expected.height));
+    throw std::invalid_argument(what + "the metadata says " + size_text(meta.width, meta.height) +
+                                expected_size_text(meta, link, expected));
   }
 }
 
