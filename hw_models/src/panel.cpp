@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <stdexcept>
@@ -338,6 +339,18 @@ bool parse_oled_spec(const std::string& spec, Panel& out) {
 
 // lcd:FILE.json: the panel JSON of to_json (what `trm calibrate` writes), which must be an LCD.
 Panel read_lcd_preset(const std::string& spec, const std::string& path) {
+  // A preset is a small regular file: a directory, a device or a FIFO named *.json is refused before it is opened
+  // (reading one would fail part-way or never end), and so is a name with a NUL, which no file has.
+  if (path.find('\0') != std::string::npos) reject(spec, "the preset file name contains a NUL character");
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (error || !std::filesystem::exists(status)) reject(spec, "cannot open the preset file " + in_quotes(path));
+  if (!std::filesystem::is_regular_file(status)) reject(spec, "the preset file " + in_quotes(path) + " is not a file");
+  constexpr std::uintmax_t kMaxPresetBytes = 1 << 20;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, error);
+  if (error || bytes > kMaxPresetBytes) {
+    reject(spec, "the preset file " + in_quotes(path) + " is not a panel preset (larger than 1 MiB or unreadable)");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) reject(spec, "cannot open the preset file " + in_quotes(path));
   nlohmann::json json;
@@ -345,6 +358,8 @@ Panel read_lcd_preset(const std::string& spec, const std::string& path) {
     json = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     reject(spec, "the preset file " + in_quotes(path) + " is not JSON (" + e.what() + ")");
+  } catch (const std::exception& e) {  // a read error of the stream itself
+    reject(spec, "cannot read the preset file " + in_quotes(path) + " (" + e.what() + ")");
   }
   Panel panel;
   try {

@@ -58,6 +58,13 @@ TEST(PanelPreset, BadFilesAreRejectedWithTheFileAndTheReason) {
   EXPECT_NE(message.find("panel JSON"), std::string::npos) << message;
   const std::filesystem::path missing = write_file("missing.json", R"({"kind": "lcd", "name": "x", "p1": 0})");
   EXPECT_NE(rejection("lcd:" + missing.string()).find("missing \"p2\""), std::string::npos);
+  // What is not a small regular file is refused before it is read (a directory failed the stream part-way).
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "trm_preset_dir.json";
+  std::filesystem::create_directories(dir);
+  EXPECT_NE(rejection("lcd:" + dir.string()).find("is not a file"), std::string::npos);
+  std::filesystem::remove(dir);
+  EXPECT_NE(rejection(std::string("lcd:.\0\0aP.json", 15)).find("invalid panel"), std::string::npos);  // a NUL
+  EXPECT_NE(rejection("lcd:/dev/null.json").find("cannot open"), std::string::npos);
   for (const auto& path : {garbage, oled_file, falling, missing}) std::filesystem::remove(path);
 }
 
