@@ -400,27 +400,31 @@ CompareResult run_compare(const CompareOptions& options,
     result.continuous_blur_arcmin = std::numeric_limits<double>::quiet_NaN();
   }
   const Gaze exact_pursuit = Gaze::perfect_pursuit(result.target_velocity_deg_s);
+  // Judder from frame to frame: one sample per frame (the frame's light integrated), so the panel's own pulse
+  // within a frame, which every method shares, is not counted; what is left is where each frame puts the target.
+  RetinaOptions per_frame = retina;
+  per_frame.substeps = 1;
+  // What every method is measured against, seen once: full rate's x-t images and the continuous motion's.
+  cv::Mat full_rate_seen, full_rate_per_frame, continuous;
+  if (full_levels.rows >= 2) {
+    full_rate_seen = target_frame_xt(full_levels, light, viewer, gaze, retina);
+    full_rate_per_frame = target_frame_xt(full_levels, light, viewer, gaze, per_frame);
+    continuous = ideal_xt(profile, viewer, result.target_velocity_deg_s, result.target_velocity_deg_s,
+                          full_rate_seen.rows, 1.0 / xt_rate);
+  }
   for (const std::string& spec : methods) {
     cv::Mat levels;
     MethodMeasure measure = spec == "full" ? full_rate : run_method(spec, levels);
     if (spec == "full") levels = full_levels;
-    if (levels.rows >= 2) {
+    if (levels.rows >= 2 && !full_rate_seen.empty()) {
       const cv::Mat seen = target_frame_xt(levels, light, viewer, gaze, retina);
-      const cv::Mat full_rate_seen = target_frame_xt(full_levels, light, viewer, gaze, retina);
-      const cv::Mat continuous = ideal_xt(profile, viewer, result.target_velocity_deg_s,
-                                          result.target_velocity_deg_s, seen.rows, 1.0 / xt_rate);
       measure.energy_vs_full_rate =
           visual_difference_energy(seen, full_rate_seen, viewer.pixels_per_degree, xt_rate, lag);
       measure.energy_vs_continuous =
           visual_difference_energy(seen, continuous, viewer.pixels_per_degree, xt_rate, lag);
-      // Judder from frame to frame: one sample per frame (the frame's light integrated), so the panel's own pulse
-      // within a frame, which every method shares, is not counted; what is left is where each frame puts the target.
-      RetinaOptions per_frame = retina;
-      per_frame.substeps = 1;
       // Only the target's own columns (in its frame they stay where it stood at t = 0): other objects on the line
       // move in that frame, and their motion is no alias.
       const cv::Mat per_frame_seen = target_frame_xt(levels, light, viewer, gaze, per_frame);
-      const cv::Mat full_rate_per_frame = target_frame_xt(full_levels, light, viewer, gaze, per_frame);
       const cv::Range target_columns(std::max(0, judder_begin), std::min(per_frame_seen.cols, judder_end));
       if (target_columns.size() >= 2) {
         const cv::Mat mine = per_frame_seen.colRange(target_columns).clone();
