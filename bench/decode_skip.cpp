@@ -1,6 +1,6 @@
 // Decode time of the fixed-point streaming decoder with the DESIGN §7 skips on and off
-// (FixedDecoderConfig::skip_unneeded), on the static scene (every line of a reduced frame skips the motion test)
-// and a moving one (discs). Items are decoded views. BM_DecodeSkipRatio times both paths in each iteration and
+// (FixedDecoderConfig::skip_unneeded), on the static scene (every line of a reduced frame skips the motion test),
+// a moving one (discs) and a grey one (text: every line computes one channel, the chroma skip). Items are decoded views. BM_DecodeSkipRatio times both paths in each iteration and
 // reports time(skip) / time(full path) as the counter "skip_over_full" (all views) and "reduced_skip_over_full"
 // (reduced views alone, where the motion test and the residual read are skipped).
 #include "trm/encoder.hpp"
@@ -21,7 +21,7 @@ constexpr int kWidth = 160;
 constexpr int kHeight = 120;
 constexpr int kFrames = 6;
 
-const char* scene_of(std::int64_t arg) { return arg == 0 ? "static" : "discs"; }
+const char* scene_of(std::int64_t arg) { return arg == 0 ? "static" : arg == 1 ? "discs" : "text"; }
 
 EncoderConfig link_config() {
   EncoderConfig link;
@@ -69,7 +69,7 @@ void decode_timed(FixedStreamingDecoder& decoder, const std::vector<LinkFrame>& 
   }
 }
 
-// Args: scene (0 = static, 1 = discs), skip (0 = full path, 1 = skip_unneeded).
+// Args: scene (0 = static, 1 = discs, 2 = text), skip (0 = full path, 1 = skip_unneeded).
 void BM_DecodeSkip(benchmark::State& state) {
   const std::vector<LinkFrame> frames = frames_of(scene_of(state.range(0)));
   FixedStreamingDecoder decoder(config_of(state.range(1) != 0));
@@ -77,7 +77,14 @@ void BM_DecodeSkip(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kFrames);
   state.SetLabel(std::string(scene_of(state.range(0))) + (state.range(1) != 0 ? " skip" : " full path"));
 }
-BENCHMARK(BM_DecodeSkip)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeSkip)
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({2, 0})
+    ->Args({2, 1})
+    ->Unit(benchmark::kMillisecond);
 
 // Args: scene, skip (1: the second decoder skips; 0: both run the full path, an A/A control of the ratio: two
 // decoder instances differ by several per cent on a shared machine, from where their tables land in memory).
@@ -103,6 +110,13 @@ void BM_DecodeSkipRatio(benchmark::State& state) {
   state.counters["reduced_skip_over_full"] = full_time.reduced > 0.0 ? skip_time.reduced / full_time.reduced : 0.0;
   state.SetLabel(std::string(scene_of(state.range(0))) + (state.range(1) != 0 ? " skip / full" : " A/A control"));
 }
-BENCHMARK(BM_DecodeSkipRatio)->Args({0, 1})->Args({0, 0})->Args({1, 1})->Args({1, 0})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DecodeSkipRatio)
+    ->Args({0, 1})
+    ->Args({0, 0})
+    ->Args({1, 1})
+    ->Args({1, 0})
+    ->Args({2, 1})
+    ->Args({2, 0})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace

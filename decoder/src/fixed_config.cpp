@@ -52,6 +52,7 @@ void FixedDecoderConfig::validate() const {
     }
   }
   require_range("linear light", "linear_frac_bits", linear_frac_bits, 8, 28);
+  require_range("execution", "threads", threads, 1, kMaxDecoderThreads);
   if (link.resample_space == ResampleSpace::Linear) {
     const std::string stage = "D (linear resample space)";
     require_range(stage, "linear_resample_frac_bits", linear_resample_frac_bits, 16, 40);

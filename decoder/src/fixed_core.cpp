@@ -48,9 +48,12 @@ FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye)
   out.frame.meta = meta;
   out.frame.meta.width = full.width;
   out.frame.meta.height = full.height;
+  const bool planes = config().report_planes;
+  // A spare with report planes where they are wanted (and none where not: the held output keeps the codes only).
+  const auto fits = [planes](const cv::Mat& plane) { return planes ? unshared(plane) : plane.empty(); };
   for (const DecodedFrame& spare : eye.spare_outputs) {
-    if (unshared(spare.wanted_linear) && unshared(spare.drive) && unshared(spare.drive_codes) &&
-        unshared(spare.emitted_linear)) {
+    if (unshared(spare.drive_codes) && fits(spare.wanted_linear) && fits(spare.drive) &&
+        fits(spare.emitted_linear)) {
       out.frame.wanted_linear = spare.wanted_linear;
       out.frame.drive = spare.drive;
       out.frame.drive_codes = spare.drive_codes;
@@ -58,10 +61,12 @@ FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye)
       return out;
     }
   }
-  out.frame.wanted_linear.create(full, CV_64FC3);
-  out.frame.drive.create(full, CV_64FC3);
   out.frame.drive_codes.create(full, CV_16UC3);
-  out.frame.emitted_linear.create(full, CV_64FC3);
+  if (planes) {
+    out.frame.wanted_linear.create(full, CV_64FC3);
+    out.frame.drive.create(full, CV_64FC3);
+    out.frame.emitted_linear.create(full, CV_64FC3);
+  }
   // Two in flight (the one returned and the held output) and one being filled cover a caller that keeps one view.
   constexpr std::size_t kSpareOutputs = 3;
   DecodedFrame spare;
@@ -85,23 +90,28 @@ void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
 
 Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const {
   const int k = 3 * x + ch;
-  out.frame.wanted_linear.ptr<double>(y)[k] = kernels_.linear_to_double(wanted);
+  const bool planes = config().report_planes;
+  if (planes) out.frame.wanted_linear.ptr<double>(y)[k] = kernels_.linear_to_double(wanted);
   if (!kernels_.lcd()) {
     const std::uint16_t code = kernels_.drive_code(wanted, ch);
-    out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(kernels_.drive_value(wanted, ch));
     out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = code;
-    out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(code, 0, ch);
+    if (planes) {
+      out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(kernels_.drive_value(wanted, ch));
+      out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(code, 0, ch);
+    }
     return 0;
   }
   // LCD frame stores: v_{t-1} and x_{t-1} at this sample are read, then replaced by this frame's.
   std::uint16_t& previous_code = eye.lcd_previous_drive.ptr<std::uint16_t>(y)[k];
   std::int32_t& previous_linear = eye.lcd_previous_linear.ptr<std::int32_t>(y)[k];
-  const LcdSample s = kernels_.lcd_drive(wanted, previous_linear, previous_code, out.lcd_held);
-  out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(s.drive);
+  const LcdSample s = kernels_.lcd_drive(wanted, previous_linear, previous_code, out.lcd_held, planes);
   out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = s.code;
   out.tally.counts.lcd_unreachable += s.unreachable ? 1 : 0;
   const bool contributed = config().decoder.lcd_history == LcdHistory::Contributed;
-  out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(s.code, s.previous_code, ch);
+  if (planes) {
+    out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(s.drive);
+    out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(s.code, s.previous_code, ch);
+  }
   previous_code = s.code;
   previous_linear = static_cast<std::int32_t>(contributed ? s.contributed : wanted);
   return out.full ? s.shortfall : 0;
@@ -109,15 +119,21 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
 
 void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x,
                                   const std::uint16_t* codes_row, const std::uint16_t* low0,
-                                  const std::uint16_t* low1, std::int32_t* residual_row, bool lost) const {
+                                  const std::uint16_t* low1, std::int32_t* residual_row, bool lost,
+                                  bool grey) const {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
   FrameTally& t = out.tally;
+  Raw low_linear = 0;
+  Raw full_linear = 0;
+  CompensatedSample s;
   for (int ch = 0; ch < 3; ++ch) {
-    const Raw low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
-    const Raw full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
-    // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
-    const CompensatedSample s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
+    if (ch == 0 || !grey) {
+      low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
+      full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
+      // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
+      s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
+    }
     if (out.taps != nullptr) {
       tap(out, Stage::Linear, y, x, ch, full_linear);
       tap(out, Stage::LowPass, y, x, ch, low_linear);
@@ -139,26 +155,35 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometr
   }
 }
 
+void FixedDecoderCore::start_full_lines(EyeState& eye, const Geometry& g) const {
+  if (!skipping()) return;
+  eye.residual_nonzero.assign(static_cast<std::size_t>(g.full.height), 0);
+  eye.residual_grey.assign(static_cast<std::size_t>(g.full.height), 0);
+  eye.low_grey.assign(static_cast<std::size_t>(g.reduced.height), 0);
+}
+
 void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const {
   if (!skipping()) return;
-  const int height = eye.full_size.height;
-  if (y == 0) eye.residual_nonzero.assign(static_cast<std::size_t>(height), 0);
   // The OR of the line's residual samples, accumulated as they are produced (one flip-flop) and kept as the line's
   // flag: a line held all zero is not written to the store.
   const int samples = 3 * eye.full_size.width;
   const bool nonzero = std::any_of(residual_row, residual_row + samples, [](std::int32_t v) { return v != 0; });
   eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
+  // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel).
+  eye.residual_grey[static_cast<std::size_t>(y)] = FixedKernels::grey_line(residual_row, eye.full_size.width) ? 1 : 0;
   out.tally.counts.residual_write_lines_skipped += nonzero ? 0 : 1;
 }
 
 void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
                                      const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                                     const std::int32_t* residual_row, const ReducedLineGate* gate) const {
+                                     const std::int32_t* residual_row, const ReducedLineGate* gate,
+                                     bool grey) const {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
   Raw alpha[3];
   for (int ch = 0; ch < 3; ++ch) {
-    alpha[ch] = kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
+    alpha[ch] = ch > 0 && grey ? alpha[0]
+                               : kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
     tap(out, Stage::Alpha, y, x, ch, alpha[ch]);
   }
   const bool motion_static = gate != nullptr && gate->motion_static;
@@ -177,8 +202,9 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   Raw previous[3];
   for (int ch = 0; ch < 3; ++ch) {
     // Static line (DESIGN §7): the d_{t-1} rows equal the received ones, so U of them is alpha.
-    previous[ch] = motion_static ? alpha[ch]
-                                 : kernels_.linear_of_upsampled(kernels_.upsample(prev0, prev1, col, row.upper, ch));
+    previous[ch] = motion_static  ? alpha[ch]
+                   : ch > 0 && grey ? previous[0]
+                                    : kernels_.linear_of_upsampled(kernels_.upsample(prev0, prev1, col, row.upper, ch));
   }
   FrameTally& t = out.tally;
   bool underflow = false;
@@ -191,10 +217,13 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   }
   t.weight_sum += weight;
   t.counts.weight_underflow += underflow ? 1 : 0;
+  WeightedSample s;
   for (int ch = 0; ch < 3; ++ch) {
     const Raw residual = residual_zero ? 0 : residual_row[3 * x + ch];
-    const WeightedSample s = residual_zero ? kernels_.clamp_alpha(alpha[ch])
-                                           : kernels_.add_weighted_residual(alpha[ch], weight, residual);  // Eq. 4
+    if (ch == 0 || !grey) {
+      s = residual_zero ? kernels_.clamp_alpha(alpha[ch])
+                        : kernels_.add_weighted_residual(alpha[ch], weight, residual);  // Eq. 4
+    }
     t.clipped += s.clipped ? 1 : 0;
     t.counts.alpha_clipped += s.clipped ? 1 : 0;
     t.dropped_sum += s.dropped;
@@ -251,7 +280,7 @@ void FixedDecoderCore::start_taps(FrameOutput& out, FixedStageTaps& taps, const 
 
 DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied) {
   const FrameTally& t = out.tally;
-  const double samples = 3.0 * static_cast<double>(out.frame.wanted_linear.total());
+  const double samples = 3.0 * static_cast<double>(out.frame.drive_codes.total());
   FrameStats& stats = out.frame.stats;
   stats.concealed_lines = out.concealed_lines;
   stats.clipped_fraction = static_cast<double>(t.clipped) / samples;
@@ -280,7 +309,13 @@ detail::Arrival FixedDecoderCore::classify(const LinkFrame& frame, std::span<con
 DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
   detail::check_lost_view(meta, who);
   last_counts_ = FixedStageCounts();
-  return detail::hold_lost_view(eyes_[meta.eye], meta);
+  DecodedFrame out = detail::hold_lost_view(eyes_[meta.eye], meta);
+  if (!config().report_planes) {  // a black first view comes with planes
+    out.wanted_linear.release();
+    out.drive.release();
+    out.emitted_linear.release();
+  }
+  return out;
 }
 
 

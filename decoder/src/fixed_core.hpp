@@ -6,6 +6,7 @@
 #include "fixed_kernels.hpp"
 #include "view_arrival.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <opencv2/core.hpp>
@@ -22,6 +23,17 @@ struct FrameTally {
   Raw weight_sum = 0;            // uQ.F over pixels
   Raw residual_abs_sum = 0;      // in residual format LSBs
   Raw residual_abs_max = 0;
+
+  // The tally of two parts of one frame (bands of lines decoded apart).
+  FrameTally& operator+=(const FrameTally& t) {
+    counts += t.counts;
+    clipped += t.clipped;
+    dropped_sum += t.dropped_sum;
+    weight_sum += t.weight_sum;
+    residual_abs_sum += t.residual_abs_sum;
+    residual_abs_max = std::max(residual_abs_max, t.residual_abs_max);
+    return *this;
+  }
 };
 
 // What persists between frames of one eye (DESIGN §5 frame stores).
@@ -34,6 +46,10 @@ struct EyeState {
   cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
   cv::Mat previous_low;   // d_t codes, reduced size, CV_16UC3
   std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
+  // DESIGN §7 chroma skip: one grey flag per row of the d_t store (from the flags of its D taps) and per line of the
+  // residual store (R = G = B in the stored rho); empty when not skipping.
+  std::vector<std::uint8_t> low_grey;
+  std::vector<std::uint8_t> residual_grey;
   DecodedFrame last_output;  // what this eye showed last (drive codes: the held-output store), re-shown when a
                              // view is lost
   // Planes of earlier views (output, rho, d_t) kept for reuse: one that no caller holds any more is filled again, so
@@ -68,6 +84,7 @@ class FixedDecoderCore {
   explicit FixedDecoderCore(FixedDecoderConfig config);
 
   FixedKernels& kernels() { return kernels_; }
+  const FixedKernels& kernels() const { return kernels_; }
   const FixedDecoderConfig& config() const { return kernels_.config(); }
   const FixedStageCounts& last_counts() const { return last_counts_; }
 
@@ -91,17 +108,59 @@ class FixedDecoderCore {
   void begin_lcd(FrameOutput& out, EyeState& eye) const;
   // One full-frame pixel, all channels (Eq. 2): U of the d_t rows i0/i1 of output row y, L, I from the codes row,
   // beta, shown (emitted), rho into residual_row. A lost (concealed) line takes beta = L.
+  // grey: every channel has the same codes and d_t rows here (the chroma skip): channel 0 is computed, the others
+  // take its values (counted as if computed).
   void full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* codes_row,
                   const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row,
-                  bool lost = false) const;
+                  bool lost = false, bool grey = false) const;
   // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
   // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
   // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are not read);
   // residual_zero reads no residual (residual_row may then be null) and adds nothing.
+  // grey: the received rows, the d_{t-1} rows read and the residual line are grey (the chroma skip).
   void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
                      const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                     const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr) const;
+                     const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr,
+                     bool grey = false) const;
+  // The chroma skip (DESIGN §7) of the lines these functions decide, from the grey flags of the lines they read;
+  // all false unless skipping.
+  //   full-frame output line y: its input line and U's two d_t rows grey;
+  bool full_line_grey(FrameOutput& out, bool codes_grey, bool low0_grey, bool low1_grey) const {
+    const bool grey = skipping() && codes_grey && low0_grey && low1_grey;
+    out.tally.counts.grey_lines += grey ? 1 : 0;
+    return grey;
+  }
+  //   reduced-frame output line y: U's two received rows grey, and where a residual applies the d_{t-1} rows the
+  //   motion test reads (none on a static line) and the residual line (none on a zero line);
+  bool reduced_line_grey(FrameOutput& out, const EyeState& eye, const Geometry& g, int y, bool in0_grey,
+                         bool in1_grey, bool residual_applies, const ReducedLineGate& gate) const {
+    if (!skipping() || !in0_grey || !in1_grey) return false;
+    bool grey = true;
+    if (residual_applies) {
+      const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+      const auto flag = [](const std::vector<std::uint8_t>& flags, int k) {
+        return static_cast<std::size_t>(k) < flags.size() && flags[static_cast<std::size_t>(k)] != 0;
+      };
+      grey = (gate.motion_static || (flag(eye.low_grey, row.i0) && flag(eye.low_grey, row.i1))) &&
+             (gate.residual_zero || flag(eye.residual_grey, y));
+    }
+    out.tally.counts.grey_lines += grey ? 1 : 0;
+    return grey;
+  }
+  //   row k of d_t: every input line of its vertical taps grey (flag(line) gives a line's flag); counted, and kept
+  //   in the d_t store's flags when `store`.
+  template <typename LineFlag>
+  bool reduced_row_grey(FrameOutput& out, EyeState& eye, const Geometry& g, int k, bool store, LineFlag flag) const {
+    if (!skipping()) return false;
+    bool grey = true;
+    for (int index : g.gauss_rows[static_cast<std::size_t>(k)].index) grey = grey && flag(index);
+    out.tally.counts.grey_reduced_rows += grey && store ? 1 : 0;
+    if (store) eye.low_grey[static_cast<std::size_t>(k)] = grey ? 1 : 0;
+    return grey;
+  }
   // DESIGN §7 skips (no-ops unless config().skip_unneeded):
+  // before the first line of a full frame: clears the residual-nonzero line flags;
+  void start_full_lines(EyeState& eye, const Geometry& g) const;
   // after full-frame output line y: flags the line of the residual store whose rho is not all zero (the write
   // gate), counting the lines not written;
   void end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const;

@@ -16,17 +16,17 @@ namespace {
 
 // d_t = Q_b(D(E_t)) over the whole frame: the horizontal pass on every row, then the vertical pass; link codes as
 // the d_t frame store holds them.
-cv::Mat reduce_whole_frame(const fixed_detail::FixedKernels& kernels, const Geometry& g, const cv::Mat& codes) {
+// Chroma skip (DESIGN §7): grey_rows[y] marks the grey input rows, whose horizontal pass runs on one channel; a row
+// of d_t whose taps are all grey runs its vertical pass on one channel (reduced_row_grey records its flag).
+cv::Mat reduce_whole_frame(const FixedDecoderCore& core, fixed_detail::FrameOutput& frame_out,
+                           fixed_detail::EyeState& eye, const Geometry& g, const cv::Mat& codes,
+                           const std::vector<std::uint8_t>& grey_rows) {
+  const fixed_detail::FixedKernels& kernels = core.kernels();
   const int samples = 3 * g.reduced.width;
   std::vector<std::vector<Raw>> horizontal(static_cast<std::size_t>(g.full.height), std::vector<Raw>(static_cast<std::size_t>(samples)));
   for (int y = 0; y < g.full.height; ++y) {
-    const std::uint16_t* row = codes.ptr<std::uint16_t>(y);
-    for (int k = 0; k < g.reduced.width; ++k) {
-      for (int ch = 0; ch < 3; ++ch) {
-        horizontal[static_cast<std::size_t>(y)][static_cast<std::size_t>(3 * k + ch)] =
-            kernels.gaussian_horizontal(row, g.gauss_cols[static_cast<std::size_t>(k)], ch);
-      }
-    }
+    kernels.gaussian_horizontal_line(codes.ptr<std::uint16_t>(y), g, horizontal[static_cast<std::size_t>(y)].data(),
+                                     grey_rows[static_cast<std::size_t>(y)] != 0);
   }
   cv::Mat low(g.reduced, CV_16UC3);
   std::vector<const Raw*> rows;
@@ -34,10 +34,22 @@ cv::Mat reduce_whole_frame(const fixed_detail::FixedKernels& kernels, const Geom
     const fixed_detail::PolyphaseTaps& taps = g.gauss_rows[static_cast<std::size_t>(k)];
     rows.clear();
     for (int index : taps.index) rows.push_back(horizontal[static_cast<std::size_t>(index)].data());
-    std::uint16_t* out = low.ptr<std::uint16_t>(k);
-    for (int i = 0; i < samples; ++i) out[i] = kernels.gaussian_vertical(rows.data(), taps, i);
+    const bool grey = core.reduced_row_grey(frame_out, eye, g, k, true, [&](int line) {
+      return grey_rows[static_cast<std::size_t>(line)] != 0;
+    });
+    kernels.gaussian_vertical_row(rows.data(), taps, samples, low.ptr<std::uint16_t>(k), grey);
   }
   return low;
+}
+
+// The grey detector of the chroma skip over every row of a frame of codes (all 0 when not skipping).
+std::vector<std::uint8_t> grey_rows_of(const FixedDecoderCore& core, const cv::Mat& codes) {
+  std::vector<std::uint8_t> grey(static_cast<std::size_t>(codes.rows), 0);
+  if (!core.skipping()) return grey;
+  for (int y = 0; y < codes.rows; ++y) {
+    grey[static_cast<std::size_t>(y)] = fixed_detail::FixedKernels::grey_line(codes.ptr<std::uint16_t>(y), codes.cols) ? 1 : 0;
+  }
+  return grey;
 }
 
 // The static-skip line comparator (DESIGN §7) over every reduced row: row k of the received (concealed) codes against
@@ -111,8 +123,10 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
   }
   const auto row_of = [](const cv::Mat& m, int y) { return m.ptr<std::uint16_t>(y); };
 
+  const std::vector<std::uint8_t> grey_rows = grey_rows_of(*core_, frame.codes);
   if (frame.meta.parity == Parity::Full) {
-    const cv::Mat low = reduce_whole_frame(core_->kernels(), g, frame.codes);  // d_t codes
+    core_->start_full_lines(eye, g);
+    const cv::Mat low = reduce_whole_frame(*core_, out, eye, g, frame.codes, grey_rows);  // d_t codes
     if (taps != nullptr) {
       std::vector<std::int64_t>& d = (*taps)[Stage::Reduced].values;
       for (int k = 0; k < low.rows; ++k) {
@@ -121,11 +135,15 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
       }
     }
     cv::Mat residual(g.full, CV_32SC3);
+    const std::vector<std::uint8_t>& low_grey = eye.low_grey;  // the d_t rows' flags (empty when not skipping)
+    const auto low_is_grey = [&](int k) { return !low_grey.empty() && low_grey[static_cast<std::size_t>(k)] != 0; };
     for (int y = 0; y < g.full.height; ++y) {
       const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+      const bool grey = core_->full_line_grey(out, grey_rows[static_cast<std::size_t>(y)] != 0, low_is_grey(row.i0),
+                                              low_is_grey(row.i1));
       for (int x = 0; x < g.full.width; ++x) {
         core_->full_pixel(out, eye, g, y, x, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
-                          residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y));
+                          residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y), grey);
       }
       core_->end_full_line(out, eye, y, residual.ptr<std::int32_t>(y));
     }
@@ -143,26 +161,32 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
                                                      : std::vector<std::uint8_t>();
   for (int y = 0; y < g.full.height; ++y) {
     const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+    const auto grey_of = [&](const fixed_detail::ReducedLineGate& gate) {
+      return core_->reduced_line_grey(out, eye, g, y, grey_rows[static_cast<std::size_t>(row.i0)] != 0,
+                                      grey_rows[static_cast<std::size_t>(row.i1)] != 0, residual_applies, gate);
+    };
     if (gated) {
       const fixed_detail::ReducedLineGate gate = core_->reduced_line_gate(
           out, eye, g, y, [&](int k) { return line_flags[static_cast<std::size_t>(k)]; });
       const bool read_previous = !gate.motion_static;
+      const bool grey = grey_of(gate);
       for (int x = 0; x < g.full.width; ++x) {
         core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
                              read_previous ? row_of(eye.previous_low, row.i0) : nullptr,
                              read_previous ? row_of(eye.previous_low, row.i1) : nullptr,
-                             gate.residual_zero ? nullptr : eye.residual.ptr<std::int32_t>(y), &gate);
+                             gate.residual_zero ? nullptr : eye.residual.ptr<std::int32_t>(y), &gate, grey);
       }
       continue;
     }
+    const bool grey = grey_of(fixed_detail::ReducedLineGate{});
     for (int x = 0; x < g.full.width; ++x) {
       if (residual_applies) {
         core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
                              row_of(eye.previous_low, row.i0), row_of(eye.previous_low, row.i1),
-                             eye.residual.ptr<std::int32_t>(y));
+                             eye.residual.ptr<std::int32_t>(y), nullptr, grey);
       } else {
         core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1), nullptr, nullptr,
-                             nullptr);
+                             nullptr, nullptr, grey);
       }
     }
   }

@@ -102,6 +102,13 @@ class FixedKernels {
   // an exact half-code tie rounds up, as the encoder's quantise_reduced does. Linear space: the sum rounded to uQ1.P
   // and re-encoded through the threshold ROM (thresholds from quantise_reduced).
   std::uint16_t gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const;
+  // D's two halves over a line, as the schedules run them: out[3k + ch] = gaussian_horizontal(codes_row,
+  // g.gauss_cols[k], ch) for every reduced column k; out[i] = gaussian_vertical(rows, taps, i) for i < samples. A
+  // grey line (every pixel R = G = B, the chroma skip) computes channel 0 and copies it. The same bits as the
+  // per-sample functions (one accumulation per sample, all three channels in one pass over the taps).
+  void gaussian_horizontal_line(const std::uint16_t* codes_row, const Geometry& g, Raw* out, bool grey) const;
+  void gaussian_vertical_row(const Raw* const* rows, const PolyphaseTaps& taps, int samples, std::uint16_t* out,
+                             bool grey) const;
   // Linear space: the link code the encoder gives linear value x (uQ1.P): the largest k with x >= T_k.
   std::uint16_t encode_linear(Raw x) const;
 
@@ -153,8 +160,10 @@ class FixedKernels {
 
   bool lcd() const { return lcd_; }
   // LCD (Eq. 7 inverse): the drive code whose merge with v_{t-1} = previous_code reaches m = ((x_t + x_{t-1})/2)^(1/g).
-  // held: the eye's first frame, x_{t-1} = x_t and the pixel held (M(v, v)); returns the held code.
-  LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const;
+  // held: the eye's first frame, x_{t-1} = x_t and the pixel held (M(v, v)); returns the held code. drive_value:
+  // also the report drive value v (else LcdSample::drive stays 0).
+  LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
+                      bool drive_value = true) const;
 
   // Rec. 709 luma of linear RGB (uQ1.F each); uQ1.F.
   Raw luma(const Raw* rgb) const;
@@ -172,6 +181,13 @@ class FixedKernels {
   // k, `samples` channel samples. kLineStatic: every code equals the stored one (so U of the two is the same).
   static constexpr std::uint8_t kLineStatic = 1;
   static std::uint8_t compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples);
+  // The grey detector of the chroma skip (DESIGN §7): R = G = B at every one of `pixels` interleaved pixels.
+  template <typename T>
+  static bool grey_line(const T* rgb, int pixels) {
+    bool grey = true;
+    for (int x = 0; x < pixels; ++x) grey &= (rgb[3 * x] == rgb[3 * x + 1]) & (rgb[3 * x] == rgb[3 * x + 2]);
+    return grey;
+  }
 
   // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
   std::uint16_t drive_code(Raw linear, int ch) const {

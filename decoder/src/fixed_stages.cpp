@@ -33,6 +33,60 @@ std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const Poly
   return static_cast<std::uint16_t>(fx::rounded_shift(acc, config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits, fx::Quant::Rnd));
 }
 
+void FixedKernels::gaussian_horizontal_line(const std::uint16_t* codes_row, const Geometry& g, Raw* out,
+                                            bool grey) const {
+  const int columns = g.reduced.width;
+  if (linear_space_) {  // through the resample ROM: the per-sample path
+    for (int k = 0; k < columns; ++k) {
+      const PolyphaseTaps& taps = g.gauss_cols[static_cast<std::size_t>(k)];
+      for (int ch = 0; ch < 3; ++ch) out[3 * k + ch] = grey && ch > 0 ? out[3 * k] : gaussian_horizontal(codes_row, taps, ch);
+    }
+    return;
+  }
+  const int shift = config_.gaussian_tap_frac_bits - config_.gaussian_line_frac_bits;
+  for (int k = 0; k < columns; ++k) {
+    const PolyphaseTaps& taps = g.gauss_cols[static_cast<std::size_t>(k)];
+    const int* index = taps.index.data();
+    const Raw* weight = taps.weight.data();
+    const std::size_t count = taps.weight.size();
+    Raw* o = out + 3 * k;
+    if (grey) {
+      Raw acc = 0;
+      for (std::size_t i = 0; i < count; ++i) acc += weight[i] * codes_row[3 * index[i]];
+      o[0] = o[1] = o[2] = fx::rounded_shift(acc, shift, fx::Quant::RndConv);
+      continue;
+    }
+    Raw acc0 = 0, acc1 = 0, acc2 = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint16_t* pixel = codes_row + 3 * index[i];
+      acc0 += weight[i] * pixel[0];
+      acc1 += weight[i] * pixel[1];
+      acc2 += weight[i] * pixel[2];
+    }
+    o[0] = fx::rounded_shift(acc0, shift, fx::Quant::RndConv);
+    o[1] = fx::rounded_shift(acc1, shift, fx::Quant::RndConv);
+    o[2] = fx::rounded_shift(acc2, shift, fx::Quant::RndConv);
+  }
+}
+
+void FixedKernels::gaussian_vertical_row(const Raw* const* rows, const PolyphaseTaps& taps, int samples,
+                                         std::uint16_t* out, bool grey) const {
+  if (linear_space_) {  // re-encoded through the threshold ROM: the per-sample path
+    for (int i = 0; i < samples; ++i) out[i] = grey && i % 3 > 0 ? out[i - i % 3] : gaussian_vertical(rows, taps, i);
+    return;
+  }
+  const int shift = config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits;
+  const Raw* weight = taps.weight.data();
+  const std::size_t count = taps.weight.size();
+  const int step = grey ? 3 : 1;
+  for (int i = 0; i < samples; i += step) {
+    Raw acc = 0;
+    for (std::size_t j = 0; j < count; ++j) acc += weight[j] * rows[j][i];
+    out[i] = static_cast<std::uint16_t>(fx::rounded_shift(acc, shift, fx::Quant::Rnd));
+    if (grey) out[i + 1] = out[i + 2] = out[i];
+  }
+}
+
 std::uint16_t FixedKernels::encode_linear(Raw x) const {
   // Binary search over the threshold ROM: b comparisons per reduced sample.
   return threshold_search(encode_thresholds_, x);
@@ -84,7 +138,8 @@ Raw FixedKernels::lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled
   return static_cast<Raw>((numerator + denominator / 2) / denominator);
 }
 
-LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held) const {
+LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
+                                   bool drive_value) const {
   const int F = config_.linear_frac_bits;
   const int top = max_output_code();
   const Raw two_top = 2 * static_cast<Raw>(top);
@@ -130,7 +185,7 @@ LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t
     return out;
   }
   out.code = static_cast<std::uint16_t>(search(lcd_coefficients_, j));
-  out.drive = lcd_drive_value(lcd_coefficients_, target_scaled, out.code, j);
+  if (drive_value) out.drive = lcd_drive_value(lcd_coefficients_, target_scaled, out.code, j);
   return out;
 }
 

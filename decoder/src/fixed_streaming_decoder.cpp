@@ -16,9 +16,13 @@
 #include "line_ring.hpp"
 
 #include <algorithm>
+#include <exception>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -37,14 +41,18 @@ constexpr const char* kWho = "FixedStreamingDecoder";
 // row of d_t whose vertical taps have all arrived and on_output(y, y_in, reduced_ready) for every output row whose U
 // rows exist. Nothing is stepped before input line `first` of a view (concealment: lost lines above the first intact
 // line take that line's content, so work that needs them waits for it; 0 normally).
+// A band of a view (FixedDecoderConfig::threads) starts both counters at its first rows and stops its output at
+// end_output; the steps are the whole view's, so a band's line buffers hold what they hold in a whole view.
 struct FullSchedule {
   int next_reduced = 0;
   int next_output = 0;
+  int end_output = std::numeric_limits<int>::max();
 
   template <typename OnReduced, typename OnOutput>
   void after_input(const Geometry& g, int y_in, OnReduced&& on_reduced, OnOutput&& on_output) {
+    const int output_end = std::min(g.full.height, end_output);
     for (;;) {
-      while (next_output < g.full.height && next_output <= y_in &&
+      while (next_output < output_end && next_output <= y_in &&
              g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 < next_reduced) {
         on_output(next_output++, y_in, next_reduced);
       }
@@ -60,10 +68,12 @@ struct FullSchedule {
 // The reduced-frame schedule: after input line k, on_output(y, k) for every output row whose U rows i0, i1 <= k.
 struct ReducedSchedule {
   int next_output = 0;
+  int end_output = std::numeric_limits<int>::max();
 
   template <typename OnOutput>
   void after_input(const Geometry& g, int k, OnOutput&& on_output) {
-    while (next_output < g.full.height && g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 <= k) {
+    const int output_end = std::min(g.full.height, end_output);
+    while (next_output < output_end && g.bilinear_rows[static_cast<std::size_t>(next_output)].i1 <= k) {
       on_output(next_output++, k);
     }
   }
@@ -122,6 +132,36 @@ void repeat_line(LineRing<T>& ring, int line, int samples) {
 
 namespace fixed_detail {
 
+// Output rows [begin, end) of a view decoded in bands, and the rows of d_t [reduced_begin, reduced_end) the band
+// writes to the d_t frame store (the rows its outputs need from the band above are computed again, not stored
+// twice).
+struct RowBand {
+  int begin = 0;
+  int end = 0;
+  int reduced_begin = 0;
+  int reduced_end = 0;
+};
+
+// The bands of a view: equal shares of the output rows, none shorter than kMinBandRows (a band re-reads the
+// Gaussian's support above it, so short bands waste work).
+constexpr int kMinBandRows = 64;
+
+std::vector<RowBand> row_bands(const Geometry& g, int threads) {
+  const int count = std::max(1, std::min(threads, g.full.height / kMinBandRows));
+  std::vector<RowBand> bands(static_cast<std::size_t>(count));
+  for (int b = 0; b < count; ++b) {
+    RowBand& band = bands[static_cast<std::size_t>(b)];
+    band.begin = static_cast<int>(static_cast<std::int64_t>(g.full.height) * b / count);
+    band.end = static_cast<int>(static_cast<std::int64_t>(g.full.height) * (b + 1) / count);
+    band.reduced_begin = b == 0 ? 0 : g.bilinear_rows[static_cast<std::size_t>(band.begin)].i0;
+  }
+  for (int b = 0; b < count; ++b) {
+    bands[static_cast<std::size_t>(b)].reduced_end =
+        b + 1 < count ? bands[static_cast<std::size_t>(b) + 1].reduced_begin : g.reduced.height;
+  }
+  return bands;
+}
+
 // One view in flight through the streaming schedule, line by line.
 //
 // Concealment in raster order (the reference's rules, line by line as the lines arrive):
@@ -168,6 +208,43 @@ class StreamingView {
     input(line, codes);
   }
 
+  // A whole view decoded in bands: this view takes the first band, `band_view` builds the others over the same
+  // frame stores and output, run_band computes a band from the whole view's codes, absorb joins a band's tally.
+  void open_whole() {
+    start(0);
+    std::fill(intact_.begin(), intact_.end(), std::uint8_t{1});
+  }
+  std::unique_ptr<StreamingView> band_view(const RowBand& band) const {
+    auto view = std::unique_ptr<StreamingView>(new StreamingView(*this));
+    view->out_.tally = FrameTally();
+    view->limit_to(band);
+    return view;
+  }
+  void limit_to(const RowBand& band) {
+    const Geometry& g = *g_;
+    const int first_reduced = g.bilinear_rows[static_cast<std::size_t>(band.begin)].i0;
+    store_begin_ = band.reduced_begin;
+    store_end_ = band.reduced_end;
+    if (full_) {
+      full_schedule_.next_output = band.begin;
+      full_schedule_.next_reduced = first_reduced;
+      full_schedule_.end_output = band.end;
+      band_first_input_ = std::min(band.begin, g.gauss_rows[static_cast<std::size_t>(first_reduced)].first());
+    } else {
+      reduced_schedule_.next_output = band.begin;
+      reduced_schedule_.end_output = band.end;
+      band_first_input_ = first_reduced;
+    }
+    band_end_ = band.end;
+  }
+  void run_band(const cv::Mat& codes) {
+    for (int line = band_first_input_; line < codes.rows && !band_done(); ++line) {
+      input(line, codes.ptr<std::uint16_t>(line));
+    }
+  }
+  void absorb(const StreamingView& band) { out_.tally += band.out_.tally; }
+  void mark_all_pushed() { pushed_ = meta_.height; }
+
   DecodedFrame finish() {
     if (!started_) return core_.decode_lost(meta_, kWho);
     out_.concealed_lines = lost_lines_;
@@ -186,6 +263,12 @@ class StreamingView {
   }
 
  private:
+  StreamingView(const StreamingView&) = default;
+
+  bool band_done() const {
+    if (full_) return full_schedule_.next_output >= band_end_ && full_schedule_.next_reduced >= store_end_;
+    return reduced_schedule_.next_output >= band_end_;
+  }
   bool lost(int line) const { return intact_[static_cast<std::size_t>(line)] == 0; }
   // Lines above the first intact line read as the first intact line.
   int source_line(int line) const { return std::max(line, first_); }
@@ -208,13 +291,19 @@ class StreamingView {
       delay_.emplace("E_t delay", plan.delay_lines, full_samples);
       gauss_.emplace("vertical Gaussian", plan.gauss_lines, reduced_samples);
       low_lines_.emplace("U of d_t", plan.low_lines, reduced_samples);
+      // DESIGN §7 chroma skip: a grey flag beside each line of the three line buffers.
+      delay_grey_.emplace("E_t delay grey flags", plan.delay_lines, 1);
+      gauss_grey_.emplace("vertical Gaussian grey flags", plan.gauss_lines, 1);
+      low_grey_.emplace("U of d_t grey flags", plan.low_lines, 1);
       residual_store_ = reusable_plane(eye.spare_planes, g.full, CV_32SC3);  // frame store rho
       low_store_ = reusable_plane(eye.spare_planes, g.reduced, CV_16UC3);    // frame store d_t
+      core_.start_full_lines(eye, g);
       return;
     }
     // meta.index >= 0 (checked by check_view_header), so index - 1 cannot overflow.
     residual_applies_ = eye.have_residual && eye.residual_index == meta_.index - 1;
     in_lines_.emplace("U of i", plan.reduced_lines, reduced_samples);
+    in_grey_.emplace("U of i grey flags", plan.reduced_lines, 1);
     // DESIGN §7 static skip: the line comparator's result for each line held in the U buffer (2 bits per line).
     gated_ = residual_applies_ && core_.skipping();
     line_flags_.emplace("U of i comparator flags", plan.reduced_lines, 1);
@@ -241,13 +330,10 @@ class StreamingView {
       std::copy(codes, codes + full_samples, delay_->write(y_in));
     }
     const std::uint16_t* in = delay_->read(y_in);
-    Raw* h = gauss_->write(y_in);
-    const FixedKernels& kernels = core_.kernels();
-    for (int k = 0; k < g.reduced.width; ++k) {
-      for (int ch = 0; ch < 3; ++ch) {
-        h[3 * k + ch] = kernels.gaussian_horizontal(in, g.gauss_cols[static_cast<std::size_t>(k)], ch);
-      }
-    }
+    const bool grey = core_.skipping() && FixedKernels::grey_line(in, g.full.width);
+    *delay_grey_->write(y_in) = grey ? 1 : 0;
+    *gauss_grey_->write(y_in) = grey ? 1 : 0;
+    core_.kernels().gaussian_horizontal_line(in, g, gauss_->write(y_in), grey);
   }
 
   void reduced_row(int k) {
@@ -256,13 +342,15 @@ class StreamingView {
     tap_rows_.clear();
     for (int index : taps.index) tap_rows_.push_back(gauss_->read(source_line(index)));
     std::uint16_t* d = low_lines_->write(k);
-    std::uint16_t* stored = low_store_.ptr<std::uint16_t>(k);
     const FixedKernels& kernels = core_.kernels();
     const int reduced_samples = 3 * g.reduced.width;
-    for (int i = 0; i < reduced_samples; ++i) {
-      stored[i] = kernels.gaussian_vertical(tap_rows_.data(), taps, i);
-      d[i] = stored[i];
-    }
+    const bool store = k >= store_begin_ && k < store_end_;
+    const bool grey = core_.reduced_row_grey(out_, *eye_, g, k, store, [this](int line) {
+      return *gauss_grey_->read(source_line(line)) != 0;
+    });
+    *low_grey_->write(k) = grey ? 1 : 0;
+    kernels.gaussian_vertical_row(tap_rows_.data(), taps, reduced_samples, d, grey);
+    if (store) std::copy(d, d + reduced_samples, low_store_.ptr<std::uint16_t>(k));
   }
 
   void full_output(int y) {
@@ -273,8 +361,10 @@ class StreamingView {
     const std::uint16_t* low1 = low_lines_->read(row.i1);
     std::int32_t* residual_row = residual_store_.ptr<std::int32_t>(y);
     const bool lost_line = lost(y);
+    const bool grey = core_.full_line_grey(out_, *delay_grey_->read(source_line(y)) != 0, *low_grey_->read(row.i0) != 0,
+                                           *low_grey_->read(row.i1) != 0);
     for (int x = 0; x < g.full.width; ++x) {
-      core_.full_pixel(out_, *eye_, g, y, x, codes_row, low0, low1, residual_row, lost_line);
+      core_.full_pixel(out_, *eye_, g, y, x, codes_row, low0, low1, residual_row, lost_line, grey);
     }
     core_.end_full_line(out_, *eye_, y, residual_row);
   }
@@ -289,6 +379,7 @@ class StreamingView {
     } else {
       repeat_line(*in_lines_, k, reduced_samples);
     }
+    *in_grey_->write(k) = core_.skipping() && FixedKernels::grey_line(in_lines_->read(k), g_->reduced.width) ? 1 : 0;
     if (gated_) {  // compared as the line enters the U buffer, against the d_{t-1} frame store row k
       *line_flags_->write(k) =
           FixedKernels::compare_line(eye_->previous_low.ptr<std::uint16_t>(k), in_lines_->read(k), reduced_samples);
@@ -313,8 +404,10 @@ class StreamingView {
     const std::uint16_t* prev1 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
     const std::int32_t* residual_row =
         residual_applies_ && !gate.residual_zero ? eye.residual.ptr<std::int32_t>(y) : nullptr;
+    const bool grey = core_.reduced_line_grey(out_, eye, g, y, *in_grey_->read(source_line(row.i0)) != 0,
+                                              *in_grey_->read(source_line(row.i1)) != 0, residual_applies_, gate);
     for (int x = 0; x < g.full.width; ++x) {
-      core_.reduced_pixel(out_, eye, g, y, x, in0, in1, prev0, prev1, residual_row, gated_ ? &gate : nullptr);
+      core_.reduced_pixel(out_, eye, g, y, x, in0, in1, prev0, prev1, residual_row, gated_ ? &gate : nullptr, grey);
     }
   }
 
@@ -344,6 +437,16 @@ class StreamingView {
   bool gated_ = false;
   std::optional<LineRing<std::uint16_t>> in_lines_;
   std::optional<LineRing<std::uint8_t>> line_flags_;
+  // Grey flags (chroma skip) beside the line buffers.
+  std::optional<LineRing<std::uint8_t>> delay_grey_;
+  std::optional<LineRing<std::uint8_t>> gauss_grey_;
+  std::optional<LineRing<std::uint8_t>> low_grey_;
+  std::optional<LineRing<std::uint8_t>> in_grey_;
+  // A band (run_band): d_t rows it stores, its first input line, its output end.
+  int store_begin_ = 0;
+  int store_end_ = std::numeric_limits<int>::max();
+  int band_first_input_ = 0;
+  int band_end_ = std::numeric_limits<int>::max();
 };
 
 }  // namespace fixed_detail
@@ -355,6 +458,10 @@ FixedStreamingDecoder::FixedStreamingDecoder(FixedStreamingDecoder&&) noexcept =
 FixedStreamingDecoder& FixedStreamingDecoder::operator=(FixedStreamingDecoder&&) noexcept = default;
 const FixedDecoderConfig& FixedStreamingDecoder::config() const { return core_->config(); }
 const FixedStageCounts& FixedStreamingDecoder::last_counts() const { return core_->last_counts(); }
+
+int FixedStreamingDecoder::threads_for(cv::Size full) const {
+  return static_cast<int>(fixed_detail::row_bands(core_->kernels().geometry(full), core_->config().threads).size());
+}
 
 FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
   const Geometry& g = core_->kernels().geometry(full);
@@ -410,6 +517,12 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
     // bit per full line (the only storage the skips add; OLED already keeps no LCD stores).
     add_frame_store("line: U of i comparator flag (static) vs d_{t-1}", p.reduced_lines, 1, 1);
     add_frame_store("frame: residual-nonzero line flags (rho write / read gate)", g.full.height, 1, 1);
+    // The chroma skip: a grey flag beside every line of the four line buffers, per row of the d_t store and per
+    // line of the residual store.
+    add_frame_store("line: grey flags beside the E_t delay, vertical Gaussian, U of d_t and U of i lines",
+                    p.delay_lines + p.gauss_lines + p.low_lines + p.reduced_lines, 1, 1);
+    add_frame_store("frame: grey flags of the d_t rows and the residual lines (chroma skip)",
+                    g.reduced.height + g.full.height, 1, 1);
     FixedArithmeticReport& compare = r.arithmetic.emplace_back();
     compare.stage = "line comparator i vs d_{t-1} (static skip)";
     compare.frame = "reduced";
@@ -422,6 +535,12 @@ FixedStreamingReport FixedStreamingDecoder::report(cv::Size full) const {
     nonzero.evaluated_per = "channel sample";
     nonzero.evaluations = full_samples;
     nonzero.comparators = 1;
+    FixedArithmeticReport& grey = r.arithmetic.emplace_back();
+    grey.stage = "grey detector R = G = B (chroma skip), input and residual lines";
+    grey.frame = "both";
+    grey.evaluated_per = "pixel";
+    grey.evaluations = static_cast<std::int64_t>(g.full.width) * g.full.height;
+    grey.comparators = 2;
   }
   r.concealment = std::string(
       "lost lines are replaced as they arrive, without extra line buffers: a lost line below an intact one repeats "
@@ -457,8 +576,49 @@ DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::
   if (detail::classify_arrival(frame, line_intact, lost, kWho) == detail::Arrival::Lost) return decode_lost(frame.meta);
   detail::check_link_frame(frame, core_->config().decoder.link, kWho);
   begin_view(frame.meta);
+  const bool whole = std::all_of(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
+  if (whole && core_->config().threads > 1) return decode_in_bands(frame);
   for (int y = 0; y < frame.codes.rows; ++y) {
     take_line(frame.codes.ptr<std::uint16_t>(y), line_intact.empty() || line_intact[static_cast<std::size_t>(y)] != 0);
+  }
+  return end_view();
+}
+
+DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
+  try {
+    view_->open_whole();
+    const std::vector<fixed_detail::RowBand> bands =
+        fixed_detail::row_bands(core_->kernels().geometry(cv::Size(frame.meta.full_width, frame.meta.full_height)),
+                                core_->config().threads);
+    std::vector<std::unique_ptr<fixed_detail::StreamingView>> others;
+    for (std::size_t b = 1; b < bands.size(); ++b) others.push_back(view_->band_view(bands[b]));
+    view_->limit_to(bands.front());
+    std::vector<std::exception_ptr> failed(bands.size());
+    {
+      std::vector<std::jthread> workers;
+      for (std::size_t b = 0; b < others.size(); ++b) {
+        workers.emplace_back([&, b] {
+          try {
+            others[b]->run_band(frame.codes);
+          } catch (...) {
+            failed[b + 1] = std::current_exception();
+          }
+        });
+      }
+      try {
+        view_->run_band(frame.codes);
+      } catch (...) {
+        failed[0] = std::current_exception();
+      }
+    }  // joined
+    for (const std::exception_ptr& e : failed) {
+      if (e) std::rethrow_exception(e);
+    }
+    for (const auto& band : others) view_->absorb(*band);
+    view_->mark_all_pushed();
+  } catch (...) {
+    view_.reset();
+    throw;
   }
   return end_view();
 }

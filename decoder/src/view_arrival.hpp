@@ -85,7 +85,7 @@ cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c);
 template <typename EyeState>
 DecodedFrame hold_lost_view(EyeState& eye, const FrameMeta& meta) {
   const cv::Size full(meta.full_width, meta.full_height);
-  const bool held = eye.full_size == full && !eye.last_output.drive.empty();
+  const bool held = eye.full_size == full && !eye.last_output.drive_codes.empty();
   if (!held) {
     eye = EyeState();
     eye.full_size = full;

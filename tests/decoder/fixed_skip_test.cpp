@@ -27,6 +27,8 @@ void expect_skip_counts_equal(const FixedStageCounts& a, const FixedStageCounts&
   EXPECT_EQ(a.motion_test_lines_skipped, b.motion_test_lines_skipped) << where;
   EXPECT_EQ(a.residual_read_lines_skipped, b.residual_read_lines_skipped) << where;
   EXPECT_EQ(a.residual_write_lines_skipped, b.residual_write_lines_skipped) << where;
+  EXPECT_EQ(a.grey_lines, b.grey_lines) << where;
+  EXPECT_EQ(a.grey_reduced_rows, b.grey_reduced_rows) << where;
 }
 
 // Per view: the skip counters of the skipping streaming decoder (the frame schedule's are asserted equal).
@@ -70,6 +72,8 @@ struct Rates {
   std::uint64_t motion = 0;
   std::uint64_t read = 0;
   std::uint64_t write = 0;
+  std::uint64_t grey = 0;
+  std::uint64_t all_lines = 0;
   void add(const SkipRun& run) {
     for (std::size_t n = 0; n < run.counts.size(); ++n) {
       const FrameMeta& m = run.frames[n].meta;
@@ -78,6 +82,8 @@ struct Rates {
       } else if (run.decoded[n].stats.residual_applied) {
         reduced_lines += static_cast<std::uint64_t>(m.full_height);
       }
+      grey += run.counts[n].grey_lines;
+      all_lines += static_cast<std::uint64_t>(m.full_height);
       motion += run.counts[n].motion_test_lines_skipped;
       read += run.counts[n].residual_read_lines_skipped;
       write += run.counts[n].residual_write_lines_skipped;
@@ -97,9 +103,11 @@ TEST(FixedSkip, BitIdenticalToTheFullPathOnEveryScene) {
         rates.add(decode_both_ways(encode_sequence(images, link), fixed_config(link, panel), what));
         if (HasFatalFailure()) return;
       }
-      std::printf("[ skip ] %-10s %-4s motion test %5.1f %%  residual read %5.1f %%  residual write %5.1f %% of lines\n",
+      std::printf("[ skip ] %-10s %-4s motion test %5.1f %%  residual read %5.1f %%  residual write %5.1f %%  grey "
+                  "%5.1f %% of lines\n",
                   name.c_str(), panel.c_str(), Rates::pct(rates.motion, rates.reduced_lines),
-                  Rates::pct(rates.read, rates.reduced_lines), Rates::pct(rates.write, rates.full_lines));
+                  Rates::pct(rates.read, rates.reduced_lines), Rates::pct(rates.write, rates.full_lines),
+                  Rates::pct(rates.grey, rates.all_lines));
     }
   }
 }
@@ -132,6 +140,49 @@ TEST(FixedSkip, StaticSceneSkipsTheMotionTestOnEveryLine) {
       EXPECT_EQ(checked, 5);  // stereo, 6 frames: every reduced view after each eye's first full view
     }
   }
+}
+
+// The chroma skip: 16x48 at r = 1/2 (8x24 reduced). Full frame: grey everywhere except one red pixel on line 40, so
+// input line 10 is not grey, nor are the d_t rows whose vertical taps reach it, nor the output lines whose U rows
+// include one of those; the rest is. The reduced frame after it: grey received rows, so its lines are grey where
+// the d_{t-1} rows it reads and the residual line are. Both schedules count alike (decode_both_ways), and every
+// output is the full path's.
+TEST(FixedSkip, GreyLinesComputeOneChannelWithTheSameBits) {
+  const EncoderConfig link = link_config(0.5);
+  const FixedDecoderConfig config = fixed_config(link, "vive");
+  std::vector<cv::Mat> images;
+  for (int t = 0; t < 2; ++t) {
+    cv::Mat image(48, 16, CV_64FC3);
+    for (int y = 0; y < 48; ++y) {
+      for (int x = 0; x < 16; ++x) {
+        const double v = 0.05 + 0.05 * ((x + y + t) % 7);  // grey texture, clipping at the steps
+        image.at<cv::Vec3d>(y, x) = cv::Vec3d(v, v, v);
+      }
+    }
+    if (t == 0) image.at<cv::Vec3d>(40, 5) = cv::Vec3d(0.9, 0.1, 0.1);
+    images.push_back(image);
+  }
+  const std::vector<LinkFrame> frames = encode_sequence(images, link);
+  const SkipRun run = decode_both_ways(frames, config, "grey");
+  ASSERT_FALSE(HasFatalFailure());
+  const FixedStageCounts& full = run.counts[0];
+  EXPECT_GT(full.grey_reduced_rows, 0u);
+  EXPECT_LT(full.grey_reduced_rows, 24u);
+  EXPECT_GT(full.grey_lines, 0u);
+  EXPECT_LT(full.grey_lines, 48u);
+  EXPECT_EQ(run.counts[1].grey_reduced_rows, 0u);  // reduced frames compute no d_t
+  EXPECT_GT(run.counts[1].grey_lines, 0u);
+  EXPECT_LT(run.counts[1].grey_lines, 48u);  // the d_{t-1} rows the red pixel reached
+  // An all-grey sequence: every line grey once the residual lines are grey; a colour one: none.
+  for (cv::Mat& image : images) image.at<cv::Vec3d>(40, 5) = cv::Vec3d(0.5, 0.5, 0.5);
+  const SkipRun all_grey = decode_both_ways(encode_sequence(images, link), config, "all grey");
+  ASSERT_FALSE(HasFatalFailure());
+  EXPECT_EQ(all_grey.counts[0].grey_lines, 48u);
+  EXPECT_EQ(all_grey.counts[0].grey_reduced_rows, 24u);
+  EXPECT_EQ(all_grey.counts[1].grey_lines, 48u);
+  const SkipRun colour = decode_both_ways(encode_sequence(scene_images("panorama", 16, 16, 2), link), config, "colour");
+  ASSERT_FALSE(HasFatalFailure());
+  EXPECT_EQ(colour.counts[0].grey_lines + colour.counts[1].grey_lines, 0u);
 }
 
 // A smooth, dim scene never clips: no full line is written to the residual store and no reduced line reads one.

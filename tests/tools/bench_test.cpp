@@ -25,7 +25,7 @@ void expect_positive(const nlohmann::json& value, const std::string& what) {
 TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
   ScratchDir dir("trm_bench_");
   const std::string json_path = dir.str("bench.json");
-  const auto result = run_trm("bench --quick --json " + json_path);
+  const auto result = run_trm("bench --quick --threads 2 --json " + json_path);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("opencv-float32"), std::string::npos) << result.output;
   std::ifstream in(json_path);
@@ -56,7 +56,8 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
       ASSERT_EQ(d["repeat_seconds"].size(), 2u) << name;
       for (const nlohmann::json& s : d["repeat_seconds"]) expect_positive(s, name + " repeat");
     }
-    EXPECT_EQ(names, (std::set<std::string>{"fixed", "fixed-frame", "reference", "opencv-float32"}));
+    EXPECT_EQ(names, (std::set<std::string>{"fixed", "fixed-1t", "fixed+planes", "fixed-frame", "reference",
+                                              "opencv-float32"}));
   }
   EXPECT_EQ(panels, (std::set<std::string>{"vive", "lcd"}));
 }

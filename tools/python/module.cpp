@@ -176,6 +176,8 @@ py::dict counts_of(const FixedStageCounts& c) {
   d["motion_test_lines_skipped"] = c.motion_test_lines_skipped;
   d["residual_read_lines_skipped"] = c.residual_read_lines_skipped;
   d["residual_write_lines_skipped"] = c.residual_write_lines_skipped;
+  d["grey_lines"] = c.grey_lines;
+  d["grey_reduced_rows"] = c.grey_reduced_rows;
   return d;
 }
 

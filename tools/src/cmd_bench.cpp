@@ -55,6 +55,7 @@ struct BenchOptions {
   std::string json;
   std::vector<std::string> sizes;   // WxH or WxHs (stereo); empty: the headset sizes
   std::vector<std::string> panels;  // empty: vive and lcd
+  int threads = 0;                  // the streaming decoder's threads; 0: the machine's hardware threads
 };
 
 BenchSize parse_bench_size(const std::string& text) {
@@ -162,14 +163,28 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   const FixedDecoderConfig config = config_for(size, panel);
   const std::vector<LinkFrame> views = encode_views(size, options, config.decoder.link);
   std::vector<Contender> contenders;
-  for (const char* impl : {"fixed", "fixed-frame", "reference"}) {
-    contenders.push_back({impl, 1,
-                          [impl, &config] {
-                            std::shared_ptr<HeadsetDecoder> d = make_decoder(impl, config);
+  // The hardware model's output is the drive codes: the streaming decoder without the report planes, on the
+  // machine's threads and on one; then as `trm run` uses it (one thread, report planes), the frame schedule and the
+  // reference, which return the planes.
+  FixedDecoderConfig codes_only = config;
+  codes_only.report_planes = false;
+  FixedDecoderConfig banded = codes_only;
+  banded.threads = options.threads;
+  const auto add = [&contenders, &size](std::string name, const char* impl, FixedDecoderConfig c) {
+    const int threads =
+        std::string(impl) == "fixed" ? FixedStreamingDecoder(c).threads_for(cv::Size(size.width, size.height)) : 1;
+    contenders.push_back({std::move(name), threads,
+                          [impl, c] {
+                            std::shared_ptr<HeadsetDecoder> d = make_decoder(impl, c);
                             return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
                           },
                           {}, 0.0, 0.0});
-  }
+  };
+  if (banded.threads > 1) add("fixed", "fixed", banded);
+  add(banded.threads > 1 ? "fixed-1t" : "fixed", "fixed", codes_only);
+  add("fixed+planes", "fixed", config);
+  add("fixed-frame", "fixed-frame", config);
+  add("reference", "reference", config);
   contenders.push_back({"opencv-float32", cv::getNumThreads(),
                         [&config] {
                           auto d = std::make_shared<bench::OpencvTrmDecoder>(config.decoder);
@@ -233,7 +248,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   text << "  hw-report memory: " << std::fixed << std::setprecision(1) << hw["on_chip_mib"].get<double>()
        << " MiB on chip + " << hw["off_chip_mib"].get<double>() << " MiB off chip + "
        << hw["output_frame_mib"].get<double>() << " MiB output drive codes = " << hw["total_mib"].get<double>()
-       << " MiB (peak RSS includes the process, the encoded views and the returned double planes)\n";
+       << " MiB (peak RSS includes the process and the encoded views; fixed+planes, fixed-frame and reference "
+          "also return three double planes per view)\n";
   result["decoders"] = std::move(decoders);
   return result;
 }
@@ -254,11 +270,17 @@ void register_bench(CLI::App& app, Action& action) {
   cmd->add_option("--size", options->sizes,
                   "View size WxH, or WxHs for a stereo pair (repeatable; default 1080x1200s 2160x1200 2880x1600)");
   cmd->add_option("--panel", options->panels, "Panel (repeatable; default vive and lcd)");
+  cmd->add_option("--threads", options->threads,
+                  "Threads of the streaming decoder (bands of output lines; default: the machine's hardware threads)")
+      ->check(CLI::Range(1, kMaxDecoderThreads));
   cmd->callback([options, &action] {
     action = [options] {
       BenchOptions o = *options;
       if (o.repeats == 0) o.repeats = o.quick ? 2 : 3;
       if (o.pairs == 0) o.pairs = o.quick ? 1 : 2;
+      if (o.threads == 0) {
+        o.threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxDecoderThreads);
+      }
       if (!o.json.empty()) io::check_file_target(o.json);
       std::vector<BenchSize> sizes = o.quick ? std::vector<BenchSize>{{96, 64, true}, {128, 96, false}}
                                              : std::vector<BenchSize>{{1080, 1200, true}, {2160, 1200, false},

@@ -164,7 +164,9 @@ rig::RigFrame to_rig_frame(const DecodedFrame& decoded, int bits) {
   return f;
 }
 
-int run_feed(const FeedSettings& s, const PipelineOptions& pipeline) {
+int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
+  PipelineOptions pipeline = options_given;
+  pipeline.report_planes = false;  // the rig is sent the drive codes alone
   if (s.list) {
     const rig::HidApi& api = s.hid_backend.empty() ? rig::linked_hidapi() : rig::hidapi_backend(s.hid_backend);
     std::cout << rig::format_listing(rig::list_devices(api));

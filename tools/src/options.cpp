@@ -112,6 +112,8 @@ FixedDecoderConfig fixed_config_of(const PipelineOptions& options) {
   config.decoder.output_bits = options.output_bits;
   config.decoder.lcd_history = options.lcd_history;
   config.skip_unneeded = !options.no_skip;
+  config.threads = options.threads;
+  config.report_planes = options.report_planes;
   if (options.residual_bits != 0) config.residual = residual_format_of_bits(options.residual_bits, config.linear_frac_bits);
   return config;
 }
@@ -201,6 +203,11 @@ void PipelineOptions::add_options(CLI::App& cmd) {
   cmd.add_flag("--no-skip", no_skip,
                "Fixed-point decoders: do not skip the work a scene does not need (static lines' motion test, "
                "all-zero residual lines); the output is bit-identical either way");
+  cmd.add_option("--threads", threads,
+                 "Fixed-point streaming decoder: threads per view (bands of output lines, each with its own line "
+                 "buffers); the output is bit-identical for every count")
+      ->check(CLI::Range(1, kMaxDecoderThreads))
+      ->capture_default_str();
   cmd.add_option_function<std::string>(
          "--impl",
          [this](const std::string& name) {

@@ -37,6 +37,9 @@ struct PipelineOptions {
   int residual_bits = 0;              // fixed impl: residual store width N (sQ2.(N-2)); 0 = the default
   bool no_skip = false;               // fixed impl: run the full path everywhere (FixedDecoderConfig::skip_unneeded)
   LcdHistory lcd_history = LcdHistory::Wanted;
+  int threads = 1;                    // fixed impl: FixedDecoderConfig::threads
+  bool report_planes = true;          // fixed impl: FixedDecoderConfig::report_planes (not an option: trm feed,
+                                      // whose rig takes the drive codes alone, turns them off)
 
   // Simulated display link (off when link_preset is empty and no fault or capture is asked for).
   std::string link_preset;            // dp1.2 ... custom:RATE:EFF

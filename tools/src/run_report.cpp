@@ -28,7 +28,9 @@ Json events_json(const FixedStageCounts& c) {
             {"weight_underflow", c.weight_underflow}, {"lcd_unreachable", c.lcd_unreachable}};
   j["skipped"] = {{"motion_test_lines", c.motion_test_lines_skipped},
                   {"residual_read_lines", c.residual_read_lines_skipped},
-                  {"residual_write_lines", c.residual_write_lines_skipped}};
+                  {"residual_write_lines", c.residual_write_lines_skipped},
+                  {"grey_lines_one_channel", c.grey_lines},
+                  {"grey_reduced_rows_one_channel", c.grey_reduced_rows}};
   return j;
 }
 
@@ -116,6 +118,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     fixed_totals_ += c;
     if (meta.parity == Parity::Reduced && d.stats.residual_applied) skip_lines_reduced_ += meta.full_height;
     if (meta.parity == Parity::Full) skip_lines_full_ += meta.full_height;
+    skip_lines_all_ += meta.full_height;
     have_fixed_counts_ = true;
   }
   if (view.reference) {
@@ -272,7 +275,8 @@ std::string RunRecorder::summary_table() const {
     row("lines skipped (fixed-point)",
         fmt("motion test %.1f %%", share(fixed_totals_.motion_test_lines_skipped, skip_lines_reduced_)) +
             fmt(", residual read %.1f %%", share(fixed_totals_.residual_read_lines_skipped, skip_lines_reduced_)) +
-            fmt(", residual write %.1f %%", share(fixed_totals_.residual_write_lines_skipped, skip_lines_full_)));
+            fmt(", residual write %.1f %%", share(fixed_totals_.residual_write_lines_skipped, skip_lines_full_)) +
+            fmt(", grey (one channel) %.1f %%", share(fixed_totals_.grey_lines, skip_lines_all_)));
   }
   if (have_fixed_counts_ && fixed_totals_.residual_saturated > 0) {
     row("residual store saturations", std::to_string(fixed_totals_.residual_saturated) + " samples");

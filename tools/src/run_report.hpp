@@ -78,6 +78,7 @@ class RunRecorder {
   FixedStageCounts fixed_totals_;
   std::int64_t skip_lines_reduced_ = 0;  // output lines of reduced views with a residual (motion / residual-read skips)
   std::int64_t skip_lines_full_ = 0;     // output lines of full views (residual-write skips)
+  std::int64_t skip_lines_all_ = 0;      // output lines of every view (grey skips)
   bool have_fixed_counts_ = false;
   double sum_render_ = 0;
   double sum_pixels_rendered_ = 0, sum_pixels_sent_ = 0, sum_pixels_full_ = 0;

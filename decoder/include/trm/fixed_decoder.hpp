@@ -27,6 +27,8 @@
 
 namespace trm {
 
+inline constexpr int kMaxDecoderThreads = 64;
+
 struct FixedDecoderConfig {
   // The algorithm parameters shared with ReferenceDecoder: link (r, sigma, transfer, bits, resample space), motion
   // sensitivity s, panel, output_bits (8 or 10), lcd_history. record_stages is ignored (no DecodeStages are filled;
@@ -143,8 +145,23 @@ struct FixedDecoderConfig {
   //     neither reads nor adds it (alpha' = clamp(alpha)). The motion test still runs there: its w feeds the
   //     frame's mean motion weight and underflow count;
   //   * OLED has no LCD stores (v_{t-1}, x_{t-1}) in any case.
-  // Grey content (R = G = B) computing one channel: not implemented (see FixedStageCounts).
+  //   * grey lines compute one channel: a line whose every pixel has R = G = B in every line it is computed from
+  //     (the input line, its D taps, U's source rows, the residual line) gives the same linear light in each
+  //     channel, so D, U, the EOTF, Eq. 2, the residual store and Eq. 4 run on the first channel and the result is
+  //     copied (one grey flag per held line beside each line buffer and frame store); the panel drive still runs
+  //     per channel (each has its own threshold ROM, and the LCD its own v_{t-1}, x_{t-1}).
   bool skip_unneeded = true;
+
+  // Execution settings: how the model runs, not what it computes (the codes and statistics are the same bits for
+  // every value; they are not part of fixed_decoder_json).
+  // The report planes of DecodedFrame (wanted_linear, drive, emitted_linear: three full-size CV_64FC3 planes, 3 x
+  // 59 MiB at 2160x1200) besides the drive codes, the hardware's output. false leaves them empty: what a testbench,
+  // a rig feed or a throughput run needs; the LCD's report drive value (a division per sample) is then not computed.
+  bool report_planes = true;
+  // FixedStreamingDecoder::decode of a whole view: bands of output lines on this many threads, each band with its
+  // own line buffers (two pipelines side by side, as a wider controller would run them). Views pushed line by line
+  // and views with lost lines run on one. In [1, kMaxDecoderThreads].
+  int threads = 1;
 
   // Throws std::invalid_argument naming the stage whose format or table is unusable.
   void validate() const;
@@ -162,6 +179,8 @@ struct FixedStageCounts {
   std::uint64_t motion_test_lines_skipped = 0;    // reduced: lines whose motion test was skipped (static, w = 1)
   std::uint64_t residual_read_lines_skipped = 0;  // reduced: lines with no residual to read or add
   std::uint64_t residual_write_lines_skipped = 0; // full: lines whose rho is all zero (not written to the store)
+  std::uint64_t grey_lines = 0;                   // output lines whose linear pipeline ran on one channel
+  std::uint64_t grey_reduced_rows = 0;            // full: rows of d_t (both D passes) computed on one channel
 
   // Totals over frames.
   FixedStageCounts& operator+=(const FixedStageCounts& c) {
@@ -174,6 +193,8 @@ struct FixedStageCounts {
     motion_test_lines_skipped += c.motion_test_lines_skipped;
     residual_read_lines_skipped += c.residual_read_lines_skipped;
     residual_write_lines_skipped += c.residual_write_lines_skipped;
+    grey_lines += c.grey_lines;
+    grey_reduced_rows += c.grey_reduced_rows;
     return *this;
   }
 };
@@ -312,6 +333,9 @@ class FixedStreamingDecoder : public HeadsetDecoder {
   const FixedStageCounts& last_counts() const;
   // Latency, line buffers / frame stores, ROMs and arithmetic per stage for a view of the given full size.
   FixedStreamingReport report(cv::Size full) const;
+  // The threads (bands of output lines) decode() runs a whole view of this full size on: config().threads, fewer
+  // for a view too short to share.
+  int threads_for(cv::Size full) const;
 
   // Opens a view as the link announces it (meta.width x meta.height: the size sent). Throws std::invalid_argument
   // for a view the decoder cannot take (the checks of decode), std::logic_error while another view is open.
@@ -337,6 +361,8 @@ class FixedStreamingDecoder : public HeadsetDecoder {
   std::unique_ptr<fixed_detail::StreamingView> view_;
   // The lines of a frame already checked whole (check_link_frame), through the incremental path.
   DecodedFrame decode_checked(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);
+  // A whole view already begun, in bands of output lines on FixedDecoderConfig::threads threads.
+  DecodedFrame decode_in_bands(const LinkFrame& frame);
   void take_line(const std::uint16_t* codes, bool intact);
 };
 

@@ -1,0 +1,172 @@
+// Execution settings of the fixed-point decoder that must not change a bit: the streaming decoder's bands of output
+// lines on several threads (FixedDecoderConfig::threads) and the drive codes without the report planes
+// (FixedDecoderConfig::report_planes).
+#include "fixed_decoder_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace trm {
+namespace {
+
+using test::encode_sequence;
+using test::expect_identical_outputs;
+using test::fixed_config;
+using test::identical;
+using test::link_config;
+using test::scene_images;
+
+FixedDecoderConfig with_threads(FixedDecoderConfig config, int threads) {
+  config.threads = threads;
+  return config;
+}
+
+void expect_skip_counts_equal(const FixedStageCounts& a, const FixedStageCounts& b, const std::string& where) {
+  EXPECT_EQ(a.motion_test_lines_skipped, b.motion_test_lines_skipped) << where;
+  EXPECT_EQ(a.residual_read_lines_skipped, b.residual_read_lines_skipped) << where;
+  EXPECT_EQ(a.residual_write_lines_skipped, b.residual_write_lines_skipped) << where;
+  EXPECT_EQ(a.grey_lines, b.grey_lines) << where;
+  EXPECT_EQ(a.grey_reduced_rows, b.grey_reduced_rows) << where;
+}
+
+// Every view through one pipeline and through 2 and 3 bands: identical outputs, statistics and counters.
+void expect_bands_identical(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
+                            const std::string& what) {
+  FixedStreamingDecoder one(with_threads(config, 1));
+  FixedStreamingDecoder two(with_threads(config, 2));
+  FixedStreamingDecoder three(with_threads(config, 3));
+  const cv::Size full(frames.front().meta.full_width, frames.front().meta.full_height);
+  ASSERT_EQ(two.threads_for(full), 2) << what << ": the view must be tall enough to share";
+  ASSERT_EQ(three.threads_for(full), 3) << what;
+  for (const LinkFrame& f : frames) {
+    const std::string where = what + " t=" + std::to_string(f.meta.index) + " eye=" + std::to_string(f.meta.eye);
+    const DecodedFrame a = one.decode(f);
+    const DecodedFrame b = two.decode(f);
+    const DecodedFrame c = three.decode(f);
+    expect_identical_outputs(a, one.last_counts(), b, two.last_counts(), where + " 2 bands");
+    expect_identical_outputs(a, one.last_counts(), c, three.last_counts(), where + " 3 bands");
+    expect_skip_counts_equal(one.last_counts(), two.last_counts(), where + " 2 bands");
+    expect_skip_counts_equal(one.last_counts(), three.last_counts(), where + " 3 bands");
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+}
+
+// 96 x 200: 200 / kMinBandRows = 3 bands at most.
+constexpr int kWidth = 96;
+constexpr int kHeight = 200;
+
+TEST(FixedThreads, BandsGiveTheSameBitsAcrossScenesReductionsAndPanels) {
+  struct Case {
+    std::string scene;
+    double r;
+    int phase;
+    std::string panel;
+    int output_bits;
+  };
+  const std::vector<Case> cases = {
+      {"discs", 0.5, 0, "vive", 8},   {"panorama", 0.5, 1, "vive", 10}, {"text", 0.4, 0, "rift", 8},
+      {"flash", 0.75, 0, "vive", 8},  {"checker", 0.25, 0, "lcd", 8},   {"discs", 0.5, 0, "lcd", 10},
+  };
+  for (const Case& c : cases) {
+    const auto frames = encode_sequence(scene_images(c.scene, kWidth, kHeight, 4), link_config(c.r, c.phase));
+    expect_bands_identical(frames, fixed_config(link_config(c.r, c.phase), c.panel, c.output_bits),
+                           c.scene + " r=" + std::to_string(c.r) + " " + c.panel);
+    if (HasFatalFailure()) return;
+  }
+}
+
+TEST(FixedThreads, BandsGiveTheSameBitsInStereoInTheLinearSpaceAndOnTheFullPath) {
+  const EncoderConfig stereo = link_config(0.5, 0, true);
+  expect_bands_identical(encode_sequence(scene_images("discs", kWidth, kHeight, 4), stereo), fixed_config(stereo),
+                         "stereo");
+  const EncoderConfig linear = link_config(0.5, 0, false, 8, ResampleSpace::Linear);
+  expect_bands_identical(encode_sequence(test::noise_images(kWidth, kHeight, 4, 7), linear), fixed_config(linear),
+                         "linear resample space, noise");
+  FixedDecoderConfig full_path = fixed_config(link_config(0.5));
+  full_path.skip_unneeded = false;
+  expect_bands_identical(encode_sequence(scene_images("static", kWidth, kHeight, 4), link_config(0.5)), full_path,
+                         "static, no skip");
+}
+
+TEST(FixedThreads, ViewsWithLostLinesAndLostViewsMatchOnePipeline) {
+  // Partial views run on one pipeline whatever the thread count; the views after them (whole again) in bands.
+  const EncoderConfig link = link_config(0.5);
+  const auto frames = encode_sequence(scene_images("discs", kWidth, kHeight, 6), link);
+  const test::ArrivalPlan plan = [](std::size_t n, const LinkFrame& f) {
+    test::Arrival a;
+    if (n == 2) a.kind = test::Arrival::Kind::Lost;
+    if (n == 1 || n == 4) {
+      a.kind = test::Arrival::Kind::Partial;
+      a.mask.assign(static_cast<std::size_t>(f.codes.rows), 1);
+      for (int y = 5; y < f.codes.rows; y += 7) a.mask[static_cast<std::size_t>(y)] = 0;
+    }
+    return a;
+  };
+  FixedStreamingDecoder one(fixed_config(link));
+  FixedStreamingDecoder two(with_threads(fixed_config(link), 2));
+  for (std::size_t n = 0; n < frames.size(); ++n) {
+    const test::Arrival arrival = plan(n, frames[n]);
+    const DecodedFrame a = test::decode_as_arrived(one, frames[n], arrival);
+    const DecodedFrame b = test::decode_as_arrived(two, frames[n], arrival);
+    expect_identical_outputs(a, one.last_counts(), b, two.last_counts(), "view " + std::to_string(n));
+    if (HasFatalFailure()) return;
+  }
+}
+
+TEST(FixedThreads, ShortViewsRunOnFewerThreadsAndCountsOutOfRangeAreRejected) {
+  FixedStreamingDecoder decoder(with_threads(fixed_config(link_config(0.5)), 8));
+  EXPECT_EQ(decoder.threads_for(cv::Size(64, 63)), 1);
+  EXPECT_EQ(decoder.threads_for(cv::Size(64, 128)), 2);
+  EXPECT_EQ(decoder.threads_for(cv::Size(64, 1200)), 8);
+  for (int bad : {0, -1, kMaxDecoderThreads + 1}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5));
+    config.threads = bad;
+    EXPECT_THROW(config.validate(), std::invalid_argument) << bad;
+    EXPECT_THROW(FixedStreamingDecoder{config}, std::invalid_argument) << bad;
+  }
+}
+
+// Without the report planes: the same drive codes, statistics and counters, the planes empty, for OLED and LCD,
+// both schedules, and the held output of a lost view is the codes alone.
+TEST(FixedThreads, DriveCodesWithoutReportPlanesAreTheSameBits) {
+  for (const std::string panel : {"vive", "lcd"}) {
+    const EncoderConfig link = link_config(0.5);
+    const auto frames = encode_sequence(scene_images("panorama", kWidth, 96, 4), link);
+    FixedDecoderConfig planes = fixed_config(link, panel);
+    FixedDecoderConfig codes_only = planes;
+    codes_only.report_planes = false;
+    FixedStreamingDecoder with(planes);
+    FixedStreamingDecoder without(codes_only);
+    FixedFrameDecoder frame_without(codes_only);
+    for (const LinkFrame& f : frames) {
+      const std::string where = panel + " t=" + std::to_string(f.meta.index);
+      const DecodedFrame a = with.decode(f);
+      const DecodedFrame b = without.decode(f);
+      const DecodedFrame c = frame_without.decode(f);
+      ASSERT_FALSE(a.wanted_linear.empty()) << where;
+      for (const DecodedFrame* d : {&b, &c}) {
+        EXPECT_TRUE(d->wanted_linear.empty() && d->drive.empty() && d->emitted_linear.empty()) << where;
+        ASSERT_TRUE(identical(a.drive_codes, d->drive_codes)) << where;
+        EXPECT_EQ(a.stats.clipped_fraction, d->stats.clipped_fraction) << where;
+        EXPECT_EQ(a.stats.residual_mean_abs, d->stats.residual_mean_abs) << where;
+        EXPECT_EQ(a.stats.mean_motion_weight, d->stats.mean_motion_weight) << where;
+        EXPECT_EQ(a.stats.lcd_unreachable_fraction, d->stats.lcd_unreachable_fraction) << where;
+      }
+      EXPECT_EQ(with.last_counts().lcd_unreachable, without.last_counts().lcd_unreachable) << where;
+      EXPECT_EQ(with.last_counts().beta_clipped, without.last_counts().beta_clipped) << where;
+    }
+    const DecodedFrame held = without.decode_lost(frames.back().meta);
+    EXPECT_TRUE(held.wanted_linear.empty()) << panel;
+    EXPECT_TRUE(identical(held.drive_codes, with.decode_lost(frames.back().meta).drive_codes)) << panel;
+    FixedStreamingDecoder fresh(codes_only);
+    const DecodedFrame black = fresh.decode_lost(frames.front().meta);
+    EXPECT_TRUE(black.wanted_linear.empty() && black.drive.empty() && black.emitted_linear.empty()) << panel;
+    EXPECT_EQ(cv::countNonZero(black.drive_codes.reshape(1)), 0) << panel;
+  }
+}
+
+}  // namespace
+}  // namespace trm
