@@ -48,6 +48,20 @@ void BM_GaussianHorizontal(benchmark::State& state) {
   const std::vector<std::uint16_t> line = random_codes(3 * kWidth, kernels.max_code(), 1);
   std::vector<Raw> out(static_cast<std::size_t>(3 * g.reduced.width));
   for (auto _ : state) {
+    kernels.gaussian_horizontal_line(line.data(), g, out.data(), false);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * g.reduced.width);
+}
+BENCHMARK(BM_GaussianHorizontal);
+
+// The same line one sample at a time (the per-sample function the line kernel replaced in the schedules).
+void BM_GaussianHorizontalPerSample(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const std::vector<std::uint16_t> line = random_codes(3 * kWidth, kernels.max_code(), 1);
+  std::vector<Raw> out(static_cast<std::size_t>(3 * g.reduced.width));
+  for (auto _ : state) {
     for (int k = 0; k < g.reduced.width; ++k) {
       for (int ch = 0; ch < 3; ++ch) {
         out[static_cast<std::size_t>(3 * k + ch)] =
@@ -58,7 +72,7 @@ void BM_GaussianHorizontal(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * 3 * g.reduced.width);
 }
-BENCHMARK(BM_GaussianHorizontal);
+BENCHMARK(BM_GaussianHorizontalPerSample);
 
 void BM_GaussianVertical(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
@@ -73,7 +87,7 @@ void BM_GaussianVertical(benchmark::State& state) {
   for (const auto& r : rows) pointers.push_back(r.data());
   std::vector<std::uint16_t> out(static_cast<std::size_t>(samples));
   for (auto _ : state) {
-    for (int i = 0; i < samples; ++i) out[static_cast<std::size_t>(i)] = kernels.gaussian_vertical(pointers.data(), taps, i);
+    kernels.gaussian_vertical_row(pointers.data(), taps, samples, out.data(), false);
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(state.iterations() * samples);
