@@ -196,8 +196,10 @@ void BM_OledDriveValue(benchmark::State& state) {
 }
 BENCHMARK(BM_OledDriveValue);
 
-// LCD drive (Eq. 7 inverse against v_{t-1}) of one output line.
+// LCD drive (Eq. 7 inverse against v_{t-1}) of one output line. Arg: 1 = also the report drive value v (what the
+// decoder computes with report planes), 0 = the code alone.
 void BM_LcdDrive(benchmark::State& state) {
+  const bool drive_value = state.range(0) != 0;
   FixedKernels kernels(config_of("lcd"));
   const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 13);
   const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 14);
@@ -205,12 +207,12 @@ void BM_LcdDrive(benchmark::State& state) {
   std::vector<std::uint16_t> codes(wanted.size());
   for (auto _ : state) {
     for (std::size_t k = 0; k < wanted.size(); ++k) {
-      codes[k] = kernels.lcd_drive(wanted[k], previous[k], previous_codes[k], false).code;
+      codes[k] = kernels.lcd_drive(wanted[k], previous[k], previous_codes[k], false, drive_value).code;
     }
     benchmark::DoNotOptimize(codes.data());
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK(BM_LcdDrive);
+BENCHMARK(BM_LcdDrive)->Arg(0)->Arg(1);
 
 }  // namespace

@@ -239,6 +239,10 @@ class FixedKernels {
   std::array<Raw, 4> lcd_coefficients_{};       // p1..p4
   std::array<Raw, 4> lcd_held_coefficients_{};  // M(v, v): 2 p1 + p2, 0, 2 p3, p4
   std::unique_ptr<fx::InterpolatedLut> lcd_target_lut_;
+  // scaled_merge(p, 2k - 1, j) for every code k >= 1 and v_{t-1} = j (rows 0..2^o - 1), then the held row
+  // (lcd_held_coefficients_, j = 0); empty above kLcdMergeTableMaxCode.
+  static constexpr int kLcdMergeTableMaxCode = 255;
+  std::vector<Raw> lcd_merge_table_;
   std::array<std::vector<Raw>, 2> lcd_end_luminance_;
   // The merge scaled to an integer: (2 Mx)^2 2^P M(t / (2 Mx), j / Mx).
   Raw scaled_merge(const std::array<Raw, 4>& p, Raw t, Raw j) const;

@@ -113,6 +113,21 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
             fx::quantise_double(lcd.emitted(static_cast<double>(end), static_cast<double>(j) / top), luminance);
       }
     }
+    // The threshold merges the drive search compares against, once per (v_{t-1}, k) instead of per step: the
+    // same integers, so the same codes. 8-bit output: 2^16 words; wider outputs compute them per step.
+    if (top <= kLcdMergeTableMaxCode) {
+      const std::size_t width = static_cast<std::size_t>(top) + 1;
+      lcd_merge_table_.resize(width * (width + 1));
+      for (std::size_t row = 0; row <= width; ++row) {
+        // Rows 0..top: v_{t-1} = row with the merge coefficients; the last row: the held merge M(v, v).
+        const bool held_row = row == width;
+        const std::array<Raw, 4>& p = held_row ? lcd_held_coefficients_ : lcd_coefficients_;
+        const Raw j = held_row ? 0 : static_cast<Raw>(row);
+        for (std::size_t k = 1; k < width; ++k) {
+          lcd_merge_table_[row * width + k] = scaled_merge(p, 2 * static_cast<Raw>(k) - 1, j);
+        }
+      }
+    }
     return;
   }
   // OLED drive: thresholds T_k = ((k - 1/2) / (2^o - 1))^gamma, the light of the drive half a code below k, rounded

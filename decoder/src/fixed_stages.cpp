@@ -154,17 +154,23 @@ LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t
     target = lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> shift));
   }
   const Raw target_scaled = target * (two_top * two_top);  // m (2 Mx)^2 2^F, as scaled_merge
-  const auto search = [&](const std::array<Raw, 4>& p, Raw j) {
+  // row: the threshold merges of this v_{t-1} from lcd_merge_table_ (null: computed per step).
+  const auto search = [&](const std::array<Raw, 4>& p, Raw j, const Raw* row) {
     int lo = 0;
     int hi = top;
     while (lo < hi) {  // the largest k with M(T_k, vp) <= m (M increases with T)
       const int mid = (lo + hi + 1) / 2;
-      if (target_scaled >= scaled_merge(p, 2 * static_cast<Raw>(mid) - 1, j)) lo = mid; else hi = mid - 1;
+      const Raw merge = row != nullptr ? row[mid] : scaled_merge(p, 2 * static_cast<Raw>(mid) - 1, j);
+      if (target_scaled >= merge) lo = mid; else hi = mid - 1;
     }
     return lo;
   };
+  const std::size_t width = static_cast<std::size_t>(top) + 1;
+  const auto table_row = [&](std::size_t row) {
+    return lcd_merge_table_.empty() ? nullptr : lcd_merge_table_.data() + row * width;
+  };
   // First frame of the eye: the pixel is taken as held at x_t (M(v, v) = x_t^(1/gamma), the same m).
-  const Raw j = held ? search(lcd_held_coefficients_, 0) : previous_code;
+  const Raw j = held ? search(lcd_held_coefficients_, 0, table_row(width)) : previous_code;
   const Raw x_previous = held ? wanted : previous_wanted;
   out.previous_code = static_cast<std::uint16_t>(j);
   out.contributed = wanted;
@@ -184,7 +190,7 @@ LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t
     out.contributed = x_effective;
     return out;
   }
-  out.code = static_cast<std::uint16_t>(search(lcd_coefficients_, j));
+  out.code = static_cast<std::uint16_t>(search(lcd_coefficients_, j, table_row(static_cast<std::size_t>(j))));
   if (drive_value) out.drive = lcd_drive_value(lcd_coefficients_, target_scaled, out.code, j);
   return out;
 }
