@@ -117,20 +117,49 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
   return out.full ? s.shortfall : 0;
 }
 
-void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x,
-                                  const std::uint16_t* codes_row, const std::uint16_t* low0,
-                                  const std::uint16_t* low1, std::int32_t* residual_row, bool lost,
-                                  bool grey) const {
-  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
-  const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,
+                                 const std::uint16_t* codes_row, const std::uint16_t* low0, const std::uint16_t* low1,
+                                 std::int32_t* residual_row, bool lost, bool grey, LineScratch& scratch) const {
+  const int samples = 3 * g.full.width;
+  scratch.first.resize(static_cast<std::size_t>(samples));
+  kernels_.upsample_line(low0, low1, g, g.bilinear_rows[static_cast<std::size_t>(y)].upper, scratch.first.data(),
+                         grey);  // L_t
+  for (int x = 0; x < g.full.width; ++x) {
+    full_pixel(out, eye, y, x, codes_row, scratch.first.data() + 3 * x, residual_row, lost, grey);
+  }
+}
+
+void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,
+                                    const std::uint16_t* in0, const std::uint16_t* in1, const std::uint16_t* prev0,
+                                    const std::uint16_t* prev1, const std::int32_t* residual_row,
+                                    const ReducedLineGate* gate, bool grey, LineScratch& scratch) const {
+  const int samples = 3 * g.full.width;
+  const Raw row_upper = g.bilinear_rows[static_cast<std::size_t>(y)].upper;
+  scratch.first.resize(static_cast<std::size_t>(samples));
+  kernels_.upsample_line(in0, in1, g, row_upper, scratch.first.data(), grey);  // Eq. 1: alpha
+  const bool motion_static = gate != nullptr && gate->motion_static;
+  const bool residual_zero = gate != nullptr && gate->residual_zero;
+  const bool previous_needed = (residual_row != nullptr || residual_zero) && !motion_static;
+  if (previous_needed) {  // L_{t-1} from the stored d_{t-1} rows
+    scratch.second.resize(static_cast<std::size_t>(samples));
+    kernels_.upsample_line(prev0, prev1, g, row_upper, scratch.second.data(), grey);
+  }
+  for (int x = 0; x < g.full.width; ++x) {
+    reduced_pixel(out, eye, y, x, scratch.first.data() + 3 * x,
+                  previous_needed ? scratch.second.data() + 3 * x : nullptr, residual_row, gate, grey);
+  }
+}
+
+void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, int y, int x, const std::uint16_t* codes_row,
+                                  const Raw* low, std::int32_t* residual_row, bool lost, bool grey) const {
   FrameTally& t = out.tally;
   Raw low_linear = 0;
   Raw full_linear = 0;
   CompensatedSample s;
   for (int ch = 0; ch < 3; ++ch) {
     if (ch == 0 || !grey) {
-      low_linear = kernels_.linear_of_upsampled(kernels_.upsample(low0, low1, col, row.upper, ch));  // L_t
-      full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);                                  // I_t
+      low_linear = low[ch];                                          // L_t
+      full_linear = kernels_.linear_of_code(codes_row[3 * x + ch]);  // I_t
       // Eq. 2; a lost line has no trustworthy beta and shows L_t (within [0, 1], so its rho is 0).
       s = lost ? kernels_.split(low_linear) : kernels_.compensate(full_linear, low_linear);
     }
@@ -174,18 +203,10 @@ void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, con
   out.tally.counts.residual_write_lines_skipped += nonzero ? 0 : 1;
 }
 
-void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
-                                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                                     const std::int32_t* residual_row, const ReducedLineGate* gate,
-                                     bool grey) const {
-  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
-  const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
-  Raw alpha[3];
-  for (int ch = 0; ch < 3; ++ch) {
-    alpha[ch] = ch > 0 && grey ? alpha[0]
-                               : kernels_.linear_of_upsampled(kernels_.upsample(in0, in1, col, row.upper, ch));  // Eq. 1
-    tap(out, Stage::Alpha, y, x, ch, alpha[ch]);
-  }
+void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, int y, int x, const Raw* alpha,
+                                     const Raw* previous_low, const std::int32_t* residual_row,
+                                     const ReducedLineGate* gate, bool grey) const {
+  for (int ch = 0; ch < 3; ++ch) tap(out, Stage::Alpha, y, x, ch, alpha[ch]);
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
   if (residual_row == nullptr && !residual_zero) {
@@ -199,13 +220,8 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, const Geom
   }
   // L_{t-1} for the motion test, from the stored d_{t-1}: the low-pass the full frame compensated against, bit for
   // bit (d_t rounds exact ties up, as the encoder's reduced frame does, so for static content it is the received i).
-  Raw previous[3];
-  for (int ch = 0; ch < 3; ++ch) {
-    // Static line (DESIGN §7): the d_{t-1} rows equal the received ones, so U of them is alpha.
-    previous[ch] = motion_static  ? alpha[ch]
-                   : ch > 0 && grey ? previous[0]
-                                    : kernels_.linear_of_upsampled(kernels_.upsample(prev0, prev1, col, row.upper, ch));
-  }
+  // Static line (DESIGN §7): the d_{t-1} rows equal the received ones, so U of them is alpha.
+  const Raw* previous = motion_static ? alpha : previous_low;
   FrameTally& t = out.tally;
   bool underflow = false;
   const Raw weight = motion_static ? kernels_.one()  // c = 0: w = 1 exactly (DESIGN §4)

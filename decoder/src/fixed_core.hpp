@@ -68,6 +68,13 @@ struct ReducedLineGate {
   bool residual_zero = false;  // rho all zero on the line: no residual read, no add
 };
 
+// The U results of one output line (L_t; alpha and L_{t-1}), reused from line to line: one per pipeline (each band
+// of a view has its own).
+struct LineScratch {
+  std::vector<Raw> first;
+  std::vector<Raw> second;
+};
+
 // Output frame under construction and the per-pixel emission shared by both schedules.
 struct FrameOutput {
   DecodedFrame frame;
@@ -106,22 +113,22 @@ class FixedDecoderCore {
   Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
   // Prepares the LCD frame stores of the eye for this frame (first frame: held history).
   void begin_lcd(FrameOutput& out, EyeState& eye) const;
-  // One full-frame pixel, all channels (Eq. 2): U of the d_t rows i0/i1 of output row y, L, I from the codes row,
-  // beta, shown (emitted), rho into residual_row. A lost (concealed) line takes beta = L.
+  // One full-frame output line (Eq. 2): U of the d_t rows low0/low1 (L_t, one pass over the line), then per pixel
+  // I from the codes row, beta, shown (emitted), rho into residual_row. A lost (concealed) line takes beta = L.
   // grey: every channel has the same codes and d_t rows here (the chroma skip): channel 0 is computed, the others
-  // take its values (counted as if computed).
-  void full_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* codes_row,
-                  const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row,
-                  bool lost = false, bool grey = false) const;
-  // One reduced-frame pixel (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from the
-  // stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
+  // take its values (counted as if computed). scratch: the line's U results (one per pipeline).
+  void full_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y, const std::uint16_t* codes_row,
+                 const std::uint16_t* low0, const std::uint16_t* low1, std::int32_t* residual_row, bool lost,
+                 bool grey, LineScratch& scratch) const;
+  // One reduced-frame output line (Eqs. 1, 4-6): alpha from the received rows in0/in1; with a residual, L_prev from
+  // the stored d_{t-1} rows prev0/prev1, w and alpha'. Without one (residual_row null), alpha alone.
   // With a gate (DESIGN §7 skips): motion_static takes L_{t-1} = alpha and w = 1 (prev0/prev1 are not read);
-  // residual_zero reads no residual (residual_row may then be null) and adds nothing.
-  // grey: the received rows, the d_{t-1} rows read and the residual line are grey (the chroma skip).
-  void reduced_pixel(FrameOutput& out, EyeState& eye, const Geometry& g, int y, int x, const std::uint16_t* in0,
-                     const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
-                     const std::int32_t* residual_row, const ReducedLineGate* gate = nullptr,
-                     bool grey = false) const;
+  // residual_zero reads no residual (residual_row may then be null) and adds nothing. grey: the received rows, the
+  // d_{t-1} rows read and the residual line are grey (the chroma skip).
+  void reduced_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y, const std::uint16_t* in0,
+                    const std::uint16_t* in1, const std::uint16_t* prev0, const std::uint16_t* prev1,
+                    const std::int32_t* residual_row, const ReducedLineGate* gate, bool grey,
+                    LineScratch& scratch) const;
   // The chroma skip (DESIGN §7) of the lines these functions decide, from the grey flags of the lines they read;
   // all false unless skipping.
   //   full-frame output line y: its input line and U's two d_t rows grey;
@@ -195,6 +202,13 @@ class FixedDecoderCore {
   DecodedFrame finish(FrameOutput&& out, EyeState& eye, bool full, bool residual_applied);
 
  private:
+  // The per-pixel steps of full_line and reduced_line, from the line's U results (low: L_t of the pixel; alpha and
+  // previous_low: alpha and L_{t-1}, previous_low null where the motion test does not read it).
+  void full_pixel(FrameOutput& out, EyeState& eye, int y, int x, const std::uint16_t* codes_row, const Raw* low,
+                  std::int32_t* residual_row, bool lost, bool grey) const;
+  void reduced_pixel(FrameOutput& out, EyeState& eye, int y, int x, const Raw* alpha, const Raw* previous_low,
+                     const std::int32_t* residual_row, const ReducedLineGate* gate, bool grey) const;
+
   FixedKernels kernels_;
   std::map<int, EyeState> eyes_;
   FixedStageCounts last_counts_;

@@ -122,6 +122,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
                       !out.full && eye.have_residual && eye.residual_index == frame.meta.index - 1);
   }
   const auto row_of = [](const cv::Mat& m, int y) { return m.ptr<std::uint16_t>(y); };
+  fixed_detail::LineScratch scratch;
 
   const std::vector<std::uint8_t> grey_rows = grey_rows_of(*core_, frame.codes);
   if (frame.meta.parity == Parity::Full) {
@@ -141,10 +142,8 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
       const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
       const bool grey = core_->full_line_grey(out, grey_rows[static_cast<std::size_t>(y)] != 0, low_is_grey(row.i0),
                                               low_is_grey(row.i1));
-      for (int x = 0; x < g.full.width; ++x) {
-        core_->full_pixel(out, eye, g, y, x, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
-                          residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y), grey);
-      }
+      core_->full_line(out, eye, g, y, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
+                       residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y), grey, scratch);
       core_->end_full_line(out, eye, y, residual.ptr<std::int32_t>(y));
     }
     eye.have_residual = true;
@@ -170,24 +169,20 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
           out, eye, g, y, [&](int k) { return line_flags[static_cast<std::size_t>(k)]; });
       const bool read_previous = !gate.motion_static;
       const bool grey = grey_of(gate);
-      for (int x = 0; x < g.full.width; ++x) {
-        core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
-                             read_previous ? row_of(eye.previous_low, row.i0) : nullptr,
-                             read_previous ? row_of(eye.previous_low, row.i1) : nullptr,
-                             gate.residual_zero ? nullptr : eye.residual.ptr<std::int32_t>(y), &gate, grey);
-      }
+      core_->reduced_line(out, eye, g, y, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
+                          read_previous ? row_of(eye.previous_low, row.i0) : nullptr,
+                          read_previous ? row_of(eye.previous_low, row.i1) : nullptr,
+                          gate.residual_zero ? nullptr : eye.residual.ptr<std::int32_t>(y), &gate, grey, scratch);
       continue;
     }
     const bool grey = grey_of(fixed_detail::ReducedLineGate{});
-    for (int x = 0; x < g.full.width; ++x) {
-      if (residual_applies) {
-        core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
-                             row_of(eye.previous_low, row.i0), row_of(eye.previous_low, row.i1),
-                             eye.residual.ptr<std::int32_t>(y), nullptr, grey);
-      } else {
-        core_->reduced_pixel(out, eye, g, y, x, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1), nullptr, nullptr,
-                             nullptr, nullptr, grey);
-      }
+    if (residual_applies) {
+      core_->reduced_line(out, eye, g, y, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
+                          row_of(eye.previous_low, row.i0), row_of(eye.previous_low, row.i1),
+                          eye.residual.ptr<std::int32_t>(y), nullptr, grey, scratch);
+    } else {
+      core_->reduced_line(out, eye, g, y, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1), nullptr, nullptr,
+                          nullptr, nullptr, grey, scratch);
     }
   }
   // The residual serves exactly one reduced frame.

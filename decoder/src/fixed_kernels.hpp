@@ -121,6 +121,23 @@ class FixedKernels {
     return blend(row0[3 * col.i0 + ch], row0[3 * col.i1 + ch], row1[3 * col.i0 + ch], row1[3 * col.i1 + ch],
                  col.upper, row_upper);
   }
+  // U and lin() over an output line: out[3x + ch] = linear_of_upsampled(upsample(row0, row1, g.bilinear_cols[x],
+  // row_upper, ch)); a grey line computes channel 0 and copies it.
+  void upsample_line(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, Raw row_upper, Raw* out,
+                     bool grey) const {
+    const int width = g.full.width;
+    for (int x = 0; x < width; ++x) {
+      const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+      Raw* o = out + 3 * x;
+      o[0] = linear_of_upsampled(upsample(row0, row1, col, row_upper, 0));
+      if (grey) {
+        o[1] = o[2] = o[0];
+        continue;
+      }
+      o[1] = linear_of_upsampled(upsample(row0, row1, col, row_upper, 1));
+      o[2] = linear_of_upsampled(upsample(row0, row1, col, row_upper, 2));
+    }
+  }
   // The bilinear arithmetic itself: four codes, weights uQ0.W, result uQb.U (Rnd); linear space: four codes through
   // the I ROM, result uQ1.F (Rnd).
   Raw blend(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const {

@@ -173,7 +173,7 @@ std::vector<RowBand> row_bands(const Geometry& g, int threads) {
 //     view's output starts up to first_intact lines later than normal.
 //   * a lost line of a reduced frame with a stored d_{t-1} takes that frame store's row (an extra row read). Whether
 //     the view is partial or lost whole is known at its first intact line, so lost lines above it are taken then.
-// Lost lines of a full frame then show L_t (full_pixel), as in the frame-at-a-time schedule. A view without any
+// Lost lines of a full frame then show L_t (full_line), as in the frame-at-a-time schedule. A view without any
 // intact line is a lost view (decode_lost): nothing of it is computed before its end.
 class StreamingView {
  public:
@@ -363,9 +363,7 @@ class StreamingView {
     const bool lost_line = lost(y);
     const bool grey = core_.full_line_grey(out_, *delay_grey_->read(source_line(y)) != 0, *low_grey_->read(row.i0) != 0,
                                            *low_grey_->read(row.i1) != 0);
-    for (int x = 0; x < g.full.width; ++x) {
-      core_.full_pixel(out_, *eye_, g, y, x, codes_row, low0, low1, residual_row, lost_line, grey);
-    }
+    core_.full_line(out_, *eye_, g, y, codes_row, low0, low1, residual_row, lost_line, grey, scratch_);
     core_.end_full_line(out_, *eye_, y, residual_row);
   }
 
@@ -406,9 +404,8 @@ class StreamingView {
         residual_applies_ && !gate.residual_zero ? eye.residual.ptr<std::int32_t>(y) : nullptr;
     const bool grey = core_.reduced_line_grey(out_, eye, g, y, *in_grey_->read(source_line(row.i0)) != 0,
                                               *in_grey_->read(source_line(row.i1)) != 0, residual_applies_, gate);
-    for (int x = 0; x < g.full.width; ++x) {
-      core_.reduced_pixel(out_, eye, g, y, x, in0, in1, prev0, prev1, residual_row, gated_ ? &gate : nullptr, grey);
-    }
+    core_.reduced_line(out_, eye, g, y, in0, in1, prev0, prev1, residual_row, gated_ ? &gate : nullptr, grey,
+                       scratch_);
   }
 
   FixedDecoderCore& core_;
@@ -432,6 +429,7 @@ class StreamingView {
   cv::Mat residual_store_;
   cv::Mat low_store_;
   std::vector<const Raw*> tap_rows_;
+  fixed_detail::LineScratch scratch_;
   // Reduced frames.
   bool residual_applies_ = false;
   bool gated_ = false;
