@@ -380,7 +380,7 @@ TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFram
   ASSERT_EQ(list.exit_code, 0) << list.output;
   const std::vector<std::pair<std::string, double>> methods = {
       {"trm", 0.625}, {"full", 1.0}, {"half-rate", 0.5}, {"interlace", 0.5}, {"interlace:double", 0.5}, {"bfi", 0.5},
-      {"ncsfi", 0.625}};
+      {"ncsfi", 0.625}, {"didyk", 1.0}, {"didyk:2,hold", 0.5}};
   for (const auto& [method, sent_ratio] : methods) {
     EXPECT_NE(list.output.find(method.substr(0, method.find(':'))), std::string::npos) << method;
     const std::string out = tmp.str("run-" + method.substr(0, method.find(':')) + std::to_string(method.size()));
@@ -449,7 +449,7 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   const nlohmann::json report = nlohmann::json::parse(in);
   std::map<std::string, nlohmann::json> by_method;
   for (const auto& m : report["methods"]) by_method[m["method"].get<std::string>()] = m;
-  ASSERT_EQ(by_method.size(), 6u);
+  ASSERT_EQ(by_method.size(), 7u);
   // Pixels: exact fractions of full rate (216x120 at r = 1/2 reduces to 108x60).
   EXPECT_DOUBLE_EQ(by_method["trm"]["pixels_rendered_saved_percent"].get<double>(), 37.5);
   EXPECT_DOUBLE_EQ(by_method["ncsfi"]["pixels_rendered_saved_percent"].get<double>(), 50.0);
@@ -458,6 +458,9 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
     EXPECT_DOUBLE_EQ(by_method[half]["pixels_sent_saved_percent"].get<double>(), 50.0) << half;
   }
   EXPECT_DOUBLE_EQ(by_method["full"]["pixels_sent_saved_percent"].get<double>(), 0.0);
+  // Didyk renders frames 0, 3 and 6 of the 8 and morphs the others GPU-side: every frame crosses the link whole.
+  EXPECT_DOUBLE_EQ(by_method["didyk"]["pixels_rendered_saved_percent"].get<double>(), 62.5);
+  EXPECT_DOUBLE_EQ(by_method["didyk"]["pixels_sent_saved_percent"].get<double>(), 0.0);
   // Light: black frames and black rows halve it; a repeat does not flicker; full rate is its own reference.
   EXPECT_NEAR(by_method["bfi"]["luminance_percent"].get<double>(), 50.0, 0.5);
   EXPECT_NEAR(by_method["interlace"]["luminance_percent"].get<double>(), 50.0, 0.5);
