@@ -79,7 +79,8 @@ struct Grid {
   cv::Size frame;
   std::vector<GridVertex> vertices;  // row-major, columns x rows
   const GridVertex& operator()(int column, int row) const {
-    return vertices[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)];
+    return vertices[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) +
+                    static_cast<std::size_t>(column)];
   }
 };
 

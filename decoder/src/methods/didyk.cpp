@@ -208,7 +208,9 @@ cv::Mat morph(const cv::Mat& source, const Grid& grid, double frames) {
   // Per destination pixel: where in the source it reads, and the layer of the triangle that wrote it.
   cv::Mat from(grid.frame, CV_64FC2);
   cv::Mat depth(grid.frame, CV_32SC1, cv::Scalar(-1));
-  const auto moved = [frames](const GridVertex& v) { return v.at + cv::Point2d(frames * v.step[0], frames * v.step[1]); };
+  const auto moved = [frames](const GridVertex& v) {
+    return v.at + cv::Point2d(frames * v.step[0], frames * v.step[1]);
+  };
   rasterise_triangles(grid, moved, [&](int x, int y, int, const auto& corners, const cv::Vec3d& w) {
     const int layer = std::min({corners[0]->layer, corners[1]->layer, corners[2]->layer});
     int& written = depth.at<int>(y, x);
