@@ -541,3 +541,20 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   std::ifstream in_two(tmp.str("two/report.json"));
   EXPECT_EQ(nlohmann::json::parse(in_two)["methods"].size(), 2u);
 }
+
+// Didyk et al.'s Fig. 8: upsampling 40 -> 120 Hz blurs a pursued edge less than native 40 Hz (each rendered frame held
+// three frames) and nearly as little as native 120 Hz, on the paper's hold-type LCD.
+TEST(Cli, DidykBlursLessThanNativeFortyHertzAndNearlyAsLittleAsOneTwenty) {
+  TempDir tmp;
+  const Result run = run_trm("compare --methods full,didyk,didyk:hold --scene discs --speed 20 --refresh 120 "
+                             "--panel lcd --size 216x120 --frames 9 --out " + tmp.str("cmp"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(tmp.str("cmp/report.json"));
+  std::map<std::string, double> blur;
+  for (const auto& m : nlohmann::json::parse(in)["methods"]) {
+    blur[m["method"].get<std::string>()] = m["motion_blur_arcmin"].get<double>();
+  }
+  EXPECT_LT(blur["full"], blur["didyk"]);
+  EXPECT_LT(blur["didyk"], blur["didyk:hold"]);
+  EXPECT_LT(blur["didyk"] - blur["full"], blur["didyk:hold"] - blur["didyk"]) << "closer to 120 Hz than to 40 Hz";
+}
