@@ -304,7 +304,7 @@ TEST(Didyk, StaticSceneAveragesToTheRenderedFrameWithinQuantisation) {
 
 TEST(Didyk, HoldIsNativeRenderingAtTheLowerRateAndAtTwoIsHalfRate) {
   const cv::Size size(48, 40);
-  const Shown hold = run("didyk:2,hold", "discs", size, 6, "vive");
+  const Shown hold = run("didyk:2-hold", "discs", size, 6, "vive");
   const Shown half = run("half-rate", "discs", size, 6, "vive");
   for (std::size_t t = 0; t < hold.codes.size(); ++t) {
     EXPECT_EQ(cv::norm(hold.codes[t], half.codes[t], cv::NORM_INF), 0.0) << t;
@@ -318,8 +318,8 @@ TEST(Didyk, HoldIsNativeRenderingAtTheLowerRateAndAtTwoIsHalfRate) {
 TEST(Didyk, OptionsAreNTwoToEightAndHold) {
   EXPECT_NO_THROW(check_display_method("didyk", "reference"));
   EXPECT_NO_THROW(check_display_method("didyk:2", "reference"));
-  EXPECT_NO_THROW(check_display_method("didyk:8,hold", "reference"));
-  for (const char* bad : {"didyk:1", "didyk:9", "didyk:3,fast", "didyk:,", "didyk:33"}) {
+  EXPECT_NO_THROW(check_display_method("didyk:8-hold", "reference"));
+  for (const char* bad : {"didyk:1", "didyk:9", "didyk:3-fast", "didyk:-", "didyk:33", "didyk:3,hold", "didyk:hold-"}) {
     EXPECT_THROW(check_display_method(bad, "reference"), std::invalid_argument) << bad;
   }
   EXPECT_THROW(check_display_method("didyk", "fixed"), std::invalid_argument);

@@ -380,7 +380,7 @@ TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFram
   ASSERT_EQ(list.exit_code, 0) << list.output;
   const std::vector<std::pair<std::string, double>> methods = {
       {"trm", 0.625}, {"full", 1.0}, {"half-rate", 0.5}, {"interlace", 0.5}, {"interlace:double", 0.5}, {"bfi", 0.5},
-      {"ncsfi", 0.625}, {"didyk", 1.0}, {"didyk:2,hold", 0.5}};
+      {"ncsfi", 0.625}, {"didyk", 1.0}, {"didyk:2-hold", 0.5}};
   for (const auto& [method, sent_ratio] : methods) {
     EXPECT_NE(list.output.find(method.substr(0, method.find(':'))), std::string::npos) << method;
     const std::string out = tmp.str("run-" + method.substr(0, method.find(':')) + std::to_string(method.size()));

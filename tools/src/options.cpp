@@ -222,8 +222,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
 
 void PipelineOptions::add_method_option(CLI::App& cmd) {
   cmd.add_option("--method", method,
-                 "Display method: trm, full, half-rate, interlace[:double], bfi, ncsfi or didyk[:N][,hold] (`trm methods` lists "
-                 "them)")
+                 "Display method: trm, full, half-rate, interlace[:double], bfi, ncsfi or didyk[:N|:hold|:N-hold] "
+                 "(`trm methods` lists them)")
       ->capture_default_str();
 }
 

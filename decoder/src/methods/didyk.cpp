@@ -3,7 +3,7 @@
 // (gamma-correct, selective blur at the range limits and where the grid distorts), and synthesises the N - 1 frames
 // after it from the rendered frame's blurred layer, warped along the scene's own motion on a snapped grid, less far
 // where the eye cannot follow. Every slot carries a whole frame: the saving is in rendering, none on the link.
-// "didyk:N,hold" is the native N-times-slower rendering the paper compares with (each rendered frame shown N times,
+// "didyk:N-hold" is the native N-times-slower rendering the paper compares with (each rendered frame shown N times,
 // nothing sent between).
 #include "trm/didyk.hpp"
 
@@ -264,20 +264,25 @@ struct DidykOptions {
 
 DidykOptions parse_didyk_option(const std::string& option) {
   DidykOptions out;
+  const auto refuse = [&option] {
+    return std::invalid_argument("method 'didyk': unknown option '" + option + "' (N from 2 to " +
+                                 std::to_string(didyk::kMaxUpsampling) + ", 'hold', or 'N-hold')");
+  };
+  if (!option.empty() && option.back() == '-') throw refuse();
   std::size_t begin = 0;
   while (begin < option.size()) {
-    const std::size_t comma = option.find(',', begin);
-    const std::string part = option.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    // '-', not ',': a method name is one field of frames.csv and one item of `trm compare --methods`.
+    const std::size_t dash = option.find('-', begin);
+    const std::string part = option.substr(begin, dash == std::string::npos ? std::string::npos : dash - begin);
     if (part == "hold") {
       out.hold = true;
     } else if (part.size() == 1 && part[0] >= '2' && part[0] <= '0' + didyk::kMaxUpsampling) {
       out.upsampling = part[0] - '0';
     } else {
-      throw std::invalid_argument("method 'didyk': unknown option '" + option + "' (N from 2 to " +
-                                  std::to_string(didyk::kMaxUpsampling) + ", 'hold', or 'N,hold')");
+      throw refuse();
     }
-    if (comma == std::string::npos) break;
-    begin = comma + 1;
+    if (dash == std::string::npos) break;
+    begin = dash + 1;
   }
   return out;
 }
@@ -372,7 +377,7 @@ DisplayMethod didyk_method() {
   m.summary = "Didyk et al. 2010: every 3rd frame rendered, boosted; the others its blur warped along the scene's "
               "motion (33 % pixels rendered, 100 % sent)";
   m.option_help = "N (2..8, default 3: every N-th frame rendered), hold (native refresh/N: each rendered frame shown "
-                  "N times, nothing sent between), or N,hold";
+                  "N times, nothing sent between), or N-hold";
   m.make_sender = [](const MethodSetup& setup) -> std::unique_ptr<MethodSender> {
     return std::make_unique<DidykSender>(setup, parse_didyk_option(setup.option));
   };
