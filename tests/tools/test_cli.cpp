@@ -380,7 +380,7 @@ TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFram
   ASSERT_EQ(list.exit_code, 0) << list.output;
   const std::vector<std::pair<std::string, double>> methods = {
       {"trm", 0.625}, {"full", 1.0}, {"half-rate", 0.5}, {"interlace", 0.5}, {"interlace:double", 0.5}, {"bfi", 0.5},
-      {"ncsfi", 0.625}};
+      {"ncsfi", 0.625}, {"didyk", 1.0}, {"didyk:2-hold", 0.5}};
   for (const auto& [method, sent_ratio] : methods) {
     EXPECT_NE(list.output.find(method.substr(0, method.find(':'))), std::string::npos) << method;
     const std::string out = tmp.str("run-" + method.substr(0, method.find(':')) + std::to_string(method.size()));
@@ -449,7 +449,7 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   const nlohmann::json report = nlohmann::json::parse(in);
   std::map<std::string, nlohmann::json> by_method;
   for (const auto& m : report["methods"]) by_method[m["method"].get<std::string>()] = m;
-  ASSERT_EQ(by_method.size(), 6u);
+  ASSERT_EQ(by_method.size(), 7u);
   // Pixels: exact fractions of full rate (216x120 at r = 1/2 reduces to 108x60).
   EXPECT_DOUBLE_EQ(by_method["trm"]["pixels_rendered_saved_percent"].get<double>(), 37.5);
   EXPECT_DOUBLE_EQ(by_method["ncsfi"]["pixels_rendered_saved_percent"].get<double>(), 50.0);
@@ -458,6 +458,9 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
     EXPECT_DOUBLE_EQ(by_method[half]["pixels_sent_saved_percent"].get<double>(), 50.0) << half;
   }
   EXPECT_DOUBLE_EQ(by_method["full"]["pixels_sent_saved_percent"].get<double>(), 0.0);
+  // Didyk renders frames 0, 3 and 6 of the 8 and morphs the others GPU-side: every frame crosses the link whole.
+  EXPECT_DOUBLE_EQ(by_method["didyk"]["pixels_rendered_saved_percent"].get<double>(), 62.5);
+  EXPECT_DOUBLE_EQ(by_method["didyk"]["pixels_sent_saved_percent"].get<double>(), 0.0);
   // Light: black frames and black rows halve it; a repeat does not flicker; full rate is its own reference.
   EXPECT_NEAR(by_method["bfi"]["luminance_percent"].get<double>(), 50.0, 0.5);
   EXPECT_NEAR(by_method["interlace"]["luminance_percent"].get<double>(), 50.0, 0.5);
@@ -537,4 +540,22 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   ASSERT_EQ(two.exit_code, 0) << two.output;
   std::ifstream in_two(tmp.str("two/report.json"));
   EXPECT_EQ(nlohmann::json::parse(in_two)["methods"].size(), 2u);
+}
+
+// Didyk et al.'s Fig. 8: upsampling 40 -> 120 Hz blurs a pursued edge less than native 40 Hz (each rendered frame held
+// three frames) and nearly as little as native 120 Hz, on the paper's hold-type LCD.
+TEST(Cli, DidykBlursLessThanNativeFortyHertzAndNearlyAsLittleAsOneTwenty) {
+  TempDir tmp;
+  const Result run = run_trm("compare --methods full,didyk,didyk:hold --scene discs --speed 20 --refresh 120 "
+                             "--panel lcd --size 216x120 --frames 9 --out " + tmp.str("cmp"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(tmp.str("cmp/report.json"));
+  const nlohmann::json report = nlohmann::json::parse(in);
+  std::map<std::string, double> blur;
+  for (const auto& m : report["methods"]) blur[m["method"].get<std::string>()] = m["motion_blur_arcmin"].get<double>();
+  ASSERT_EQ(blur.size(), 3u);
+  // Measured 10.47, 12.76 and 25.06 arcmin.
+  EXPECT_LT(blur["full"], blur["didyk"]);
+  EXPECT_LT(blur["didyk"], blur["didyk:hold"]);
+  EXPECT_LT(blur["didyk"] - blur["full"], blur["didyk:hold"] - blur["didyk"]) << "closer to 120 Hz than to 40 Hz";
 }

@@ -320,6 +320,7 @@ CompareResult run_compare(const CompareOptions& options,
     run.impl = "reference";
     run.impl_given = false;
     run.compare_reference = false;
+    run.pixels_per_degree = viewer.pixels_per_degree;  // what a method that predicts pursuit (didyk) assumes
     if (run.link_preset.empty()) run.link_preset = "dp1.4";  // bandwidth per link frame for every method
     MethodMeter meter(run.panel, run.output_bits, result.scan_line, viewer.pixels_per_degree, run.refresh_hz);
     MethodMeasure measure;

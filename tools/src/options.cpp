@@ -222,7 +222,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
 
 void PipelineOptions::add_method_option(CLI::App& cmd) {
   cmd.add_option("--method", method,
-                 "Display method: trm, full, half-rate, interlace[:double], bfi or ncsfi (`trm methods` lists them)")
+                 "Display method: trm, full, half-rate, interlace[:double], bfi, ncsfi or didyk[:N|:hold|:N-hold] "
+                 "(`trm methods` lists them)")
       ->capture_default_str();
 }
 
@@ -235,6 +236,8 @@ MethodSetup PipelineOptions::method_setup() const {
   setup.decoder = fixed_config_of(*this);
   setup.impl = method_impl();
   setup.option = find_display_method(method).option;
+  setup.scene.refresh_hz = refresh_hz;
+  setup.scene.pixels_per_degree = pixels_per_degree;
   return setup;
 }
 

@@ -26,6 +26,7 @@ struct PipelineOptions {
   double refresh_hz = 90.0;
   std::uint64_t seed = 1;
   double motion_scale = 1.0;          // SceneParams::motion_scale (set by trm compare --speed)
+  double pixels_per_degree = viewer_preset("vive").pixels_per_degree;  // the viewer (set by trm compare --viewer/--ppd)
   EncoderConfig encoder;
   double sensitivity = 10.0;
   Panel panel = parse_panel("vive");  // --panel, parsed once as it is read

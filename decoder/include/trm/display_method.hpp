@@ -10,6 +10,8 @@
 #include "trm/decoder.hpp"
 #include "trm/fixed_decoder.hpp"
 #include "trm/frame.hpp"
+#include "trm/retina.hpp"
+#include "trm/scene.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -28,6 +30,13 @@ struct MethodSetup {
   FixedDecoderConfig decoder;
   std::string impl = "reference";
   std::string option;
+  // What a method that morphs frames along the scene's motion (didyk) knows of the scene besides its frames.
+  struct SceneMotion {
+    // The scene's motion at frame t; empty for a source that reports none (an input: its frames are held still).
+    std::function<Motion(std::int64_t t)> at;
+    double refresh_hz = 90.0;  // to turn velocities into displacements per frame
+    double pixels_per_degree = viewer_preset("vive").pixels_per_degree;  // the viewer's, for the pursuit limit
+  } scene;
 };
 
 // One view the GPU side sends, with what it cost to render.

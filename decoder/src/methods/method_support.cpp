@@ -172,6 +172,10 @@ class PlainFrameDisplay : public MethodDisplay {
 
 }  // namespace
 
+std::unique_ptr<MethodDisplay> plain_frame_display(const DecoderConfig& config, Between between) {
+  return std::make_unique<PlainFrameDisplay>(config, between);
+}
+
 DisplayMethod trm_frame_method(std::string name, std::string summary, SenderFactory sender, HeadsetConfig headset) {
   DisplayMethod m;
   m.name = std::move(name);
@@ -191,9 +195,7 @@ DisplayMethod plain_frame_method(std::string name, std::string summary, Between 
   m.make_sender = [between](const MethodSetup& setup) -> std::unique_ptr<MethodSender> {
     return std::make_unique<FullViewSender>(setup.decoder.decoder.link, between == Between::Nothing);
   };
-  m.make_display = [between](const MethodSetup& setup) -> std::unique_ptr<MethodDisplay> {
-    return std::make_unique<PlainFrameDisplay>(setup.decoder.decoder, between);
-  };
+  m.make_display = [between](const MethodSetup& setup) { return plain_frame_display(setup.decoder.decoder, between); };
   return m;
 }
 

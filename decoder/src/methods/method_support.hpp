@@ -85,6 +85,9 @@ enum class Between {
   Repeat,   // the last frame again, code for code
   Black,    // a black frame
 };
+// The headset side of a method that sends whole full views: each shown through PanelShow, the slots it sends
+// nothing for filled by `between`.
+std::unique_ptr<MethodDisplay> plain_frame_display(const DecoderConfig& config, Between between);
 // A method that renders and sends whole frames (every slot, or TRM's full slots only) and shows them through
 // PanelShow: full, half-rate, bfi differ only in `between`.
 DisplayMethod plain_frame_method(std::string name, std::string summary, Between between);
