@@ -2,7 +2,8 @@
 # tools/slurm/sweep.sh on a one-node Slurm cluster started here on localhost: munged, slurmctld and slurmd run by
 # hand (no systemd) from a generated slurm.conf in a scratch directory, and are stopped on every exit. A small sweep
 # runs as 3 array tasks and a dependent merge; its sweep.csv must equal the unsharded run's byte for byte once the
-# timing columns (the only run-specific ones) are cut from both, and so must report.json without its timings.
+# timing columns (the only run-specific ones) are cut from both, and so must report.json without its timings. A
+# sweep whose shards fail must not merge, and sweep.sh --wait must say so.
 #
 # Usage: slurm_sweep_test.sh TRM REPO. Exit 77 (ctest SKIP_RETURN_CODE) only when the daemons cannot start here,
 # printing why; any other failure is a failure.
@@ -44,7 +45,7 @@ socket="$scratch/munge.socket"
 munged --foreground --force --key-file="$scratch/munge.key" --socket="$socket" --pid-file="$scratch/munged.pid" \
   --seed-file="$scratch/munged.seed" --log-file="$scratch/log/munged.log" >"$scratch/log/munged.out" 2>&1 &
 daemons+=($!)
-for _ in $(seq 50); do [[ -S "$socket" ]] && break; sleep 0.2; done
+for _ in $(seq 50); do [[ -S "$socket" ]] && break; kill -0 "${daemons[0]}" 2>/dev/null || break; sleep 0.2; done
 [[ -S "$socket" ]] || cannot_start "munged did not create its socket"
 munge --socket="$socket" --no-input | unmunge --socket="$socket" >/dev/null 2>&1 ||
   cannot_start "munged does not answer on its socket"
@@ -98,11 +99,13 @@ state=""
 for _ in $(seq 60); do
   state=$(sinfo -h -n trmnode -o %t 2>/dev/null || true)
   [[ "$state" == idle ]] && break
+  kill -0 "${daemons[1]}" 2>/dev/null || cannot_start "slurmctld exited"
+  kill -0 "${daemons[2]}" 2>/dev/null || cannot_start "slurmd exited"
   sleep 0.5
 done
 [[ "$state" == idle ]] || cannot_start "the node did not come up idle (sinfo says '${state:-nothing}')"
 
-# The sweep: three knobs at a tiny size, rejected values among them (linear_frac_bits 16), 32 points.
+# The sweep: three knobs at a tiny size, rejected values among them (linear_frac_bits 16), 31 rows.
 options=(--quick --size 24x16 --hw-size 24x16 --knob linear_frac_bits --knob residual_bits --knob exp_entries)
 work="$scratch/work"
 "$trm" sweep "${options[@]}" -o "$work/sweep" >"$scratch/log/single.out" 2>&1 ||
@@ -140,7 +143,7 @@ def without_timings(value):
     return value
 rows = without_timing_columns(single, "single")
 assert without_timing_columns(merged, "merged") == rows
-assert rows == 32, rows
+assert rows == 31, rows
 for name in ("single", "merged"):
     with open(f"{scratch}/{name}.json", "w") as out:
         directory = single if name == "single" else merged
@@ -148,4 +151,15 @@ for name in ("single", "merged"):
 PY
 cmp "$scratch/single.csv" "$scratch/merged.csv" || { echo "FAIL: merged sweep.csv differs from the unsharded run's"; exit 1; }
 cmp "$scratch/single.json" "$scratch/merged.json" || { echo "FAIL: merged report.json differs from the unsharded run's"; exit 1; }
-echo "PASS: 3 Slurm array tasks and their merge reproduce the unsharded sweep (32 rows)"
+# A shard that fails (here every one: an unknown scene) cancels the merge, and --wait says so.
+if "$repo/tools/slurm/sweep.sh" --shards 2 --trm "$trm" --wait "$scratch/failing" --quick --scene nosuchscene \
+     >"$scratch/log/failing.out" 2>&1; then
+  cat "$scratch/log/failing.out"
+  echo "FAIL: sweep.sh --wait succeeded although its shards failed"
+  exit 1
+fi
+grep -q "did not complete" "$scratch/log/failing.out" || { cat "$scratch/log/failing.out"; echo "FAIL: no error message"; exit 1; }
+grep -q "unknown scene 'nosuchscene'" "$scratch/failing/logs/shard-1.out" ||
+  { cat "$scratch/failing/logs/shard-1.out"; echo "FAIL: the shard's log lacks trm's error"; exit 1; }
+[[ ! -e "$scratch/failing/sweep" ]] || { echo "FAIL: a merge ran after failed shards"; exit 1; }
+echo "PASS: 3 Slurm array tasks and their merge reproduce the unsharded sweep (31 rows); failed shards cancel the merge"
