@@ -181,7 +181,9 @@ TEST_F(SweepShards, MergeWritesWhatASingleRunWrites) {
   int lines = 0;
   while (std::getline(merged_md, a) && std::getline(single_md, b)) {
     ++lines;
-    if (a.rfind("|", 0) != 0 && a.find("ms per view") == std::string::npos) EXPECT_EQ(a, b);
+    if (a.rfind("|", 0) != 0 && a.find("ms per view") == std::string::npos) {
+      EXPECT_EQ(a, b);
+    }
   }
   EXPECT_GT(lines, 20);
   fs::remove_all(merged);
@@ -230,7 +232,7 @@ TEST(SweepShard, PartFilesCarryEveryFieldOfThePoints) {
 
 TEST_F(SweepShards, BadShardsAreRefusedBeforeAnyOutput) {
   const fs::path out = scratch_->path() / "bad-shard";
-  for (const std::string& shard : {"0/3", "4/3", "3", "2/x", "1/0", "-1/3"}) {
+  for (const std::string shard : {"0/3", "4/3", "3", "2/x", "1/0", "-1/3"}) {
     const auto r = run_trm(kSweep + " --shard " + shard + " -o " + out.string());
     EXPECT_NE(r.exit_code, 0) << shard;
     EXPECT_NE(r.output.find("trm: error: --shard"), std::string::npos) << r.output;

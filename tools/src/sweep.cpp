@@ -393,7 +393,8 @@ SweepResult run_sweep(const SweepOptions& options,
   const SweepShard& shard = options.shard;
   // The sequence decodes this shard makes: its points (numbered as SweepShard numbers them) and the base's.
   std::int64_t decodes = 0;
-  for (std::int64_t number = 0; number < sweep_point_count(plan); ++number) decodes += shard.owns(number) ? 1 : 0;
+  const std::int64_t points = sweep_point_count(plan);
+  for (std::int64_t number = 0; number < points; ++number) decodes += shard.owns(number) ? 1 : 0;
 
   const auto start = Clock::now();
   const Recording rec = record_reference(options.pipeline);
