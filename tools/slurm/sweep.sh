@@ -15,7 +15,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 
 usage() {
   sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d; s/^# \{0,1\}//' >&2
-  exit 2
+  exit "${1:-2}"
 }
 
 shards=8
@@ -31,7 +31,7 @@ while (($#)); do
     --wait) wait_for_merge=1; shift ;;
     --sbatch-option) sbatch_options+=("${2:?--sbatch-option needs an option}"); shift 2 ;;
     --sbatch-option=*) sbatch_options+=("${1#*=}"); shift ;;
-    -h|--help) usage ;;
+    -h|--help) usage 0 ;;
     --) shift; break ;;
     -*) echo "sweep.sh: error: unknown option '$1'" >&2; usage ;;
     *) break ;;
@@ -49,9 +49,18 @@ if [[ -z "$trm" ]]; then
 fi
 [[ -n "$trm" && -x "$trm" ]] || { echo "sweep.sh: error: no trm executable (give --trm PATH)" >&2; exit 2; }
 trm=$(realpath "$trm")
+# The directories made here, deepest first, so that a refused submission can take them away again.
+created=()
+for dir in "$work/parts" "$work/logs"; do [[ -e "$dir" ]] || created+=("$dir"); done
+dir=$work
+while [[ ! -e "$dir" ]]; do created+=("$dir"); dir=$(dirname "$dir"); done
 mkdir -p "$work/parts" "$work/logs"
-array=$(sbatch --parsable "${sbatch_options[@]}" --array="1-$shards" --output="$work/logs/shard-%a.out" \
-          "$here/sweep-shard.sbatch" "$trm" "$work/parts" "$@")
+if ! array=$(sbatch --parsable "${sbatch_options[@]}" --array="1-$shards" --output="$work/logs/shard-%a.out" \
+               "$here/sweep-shard.sbatch" "$trm" "$work/parts" "$@"); then
+  for dir in "${created[@]}"; do rmdir "$dir" 2>/dev/null || true; done  # nothing was queued: leave no trace
+  echo "sweep.sh: error: sbatch refused the shard array (is Slurm set up here?)" >&2
+  exit 1
+fi
 array=${array%%;*}
 merge_options=(--parsable "${sbatch_options[@]}" --dependency="afterok:$array" --kill-on-invalid-dep=yes
                --output="$work/logs/merge.out")
