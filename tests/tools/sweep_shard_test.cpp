@@ -218,7 +218,7 @@ TEST(SweepShard, PartFilesCarryEveryFieldOfThePoints) {
     from_files.push_back(trm::cli::read_sweep_part(part.dir));
     in_memory.push_back(std::move(part));
   }
-  trm::cli::check_sweep_parts(from_files);
+  trm::cli::check_sweep_parts(from_files, tmp.path() / "merged");
   const trm::cli::SweepResult a = trm::cli::merge_sweep_parts(from_files, options);
   const trm::cli::SweepResult b = trm::cli::merge_sweep_parts(in_memory, options);
   EXPECT_EQ(trm::cli::sweep_csv(a), trm::cli::sweep_csv(b));

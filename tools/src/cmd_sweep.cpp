@@ -9,7 +9,6 @@
 #include "sweep_shard.hpp"
 
 #include <algorithm>
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -25,8 +24,6 @@ namespace trm::cli {
 
 namespace {
 
-namespace fs = std::filesystem;
-
 constexpr const char* kShardOption = "--shard";
 constexpr const char* kMergeOption = "--merge";
 constexpr const char* kOutOption = "--out";
@@ -41,41 +38,42 @@ struct SweepCli {
 };
 
 // The options of `trm sweep`, defined once: for the command line, and for reading a part's options again at a merge.
-void define_sweep_options(CLI::App& cmd, SweepCli& cli) {
-  SweepOptions& options = cli.options;
-  options.pipeline.width = 270;
-  options.pipeline.height = 300;
-  options.pipeline.default_frames = 12;
-  options.pipeline.add_options(cmd);
+void define_sweep_options(CLI::App* cmd, SweepCli* cli) {
+  SweepOptions* options = &cli->options;
+  options->pipeline.width = 270;
+  options->pipeline.height = 300;
+  options->pipeline.default_frames = 12;
+  options->pipeline.add_options(*cmd);
   // The sweep always decodes with the streaming fixed-point decoder beside the reference.
-  cmd.remove_option(cmd.get_option("--impl"));
-  cmd.get_option("--size")->description("View size WxH decoded at each point (default 270x300)");
-  cmd.get_option("--residual-bits")
+  cmd->remove_option(cmd->get_option("--impl"));
+  cmd->get_option("--size")->description("View size WxH decoded at each point (default 270x300)");
+  cmd->get_option("--residual-bits")
       ->description("Residual store width N of the base configuration, sQ2.(N-2) (default: 30, lossless)");
-  cmd.add_option("--knob", options.knobs, "Knob to sweep (repeatable; default: every knob the panel uses)");
-  cmd.add_option("--values", options.values, "Values of the one --knob, comma separated (the base value is added)")
+  cmd->add_option("--knob", options->knobs, "Knob to sweep (repeatable; default: every knob the panel uses)");
+  cmd->add_option("--values", options->values, "Values of the one --knob, comma separated (the base value is added)")
       ->delimiter(',');
-  cmd.add_option("--repeats", options.repeats, "Decodes of the sequence per point; each view's median time is reported")
+  cmd->add_option("--repeats", options->repeats,
+                  "Decodes of the sequence per point; each view's median time is reported")
       ->capture_default_str();
-  cmd.add_option_function<std::string>(
-      "--hw-size", [&options](const std::string& text) { options.hw_size = parse_view_size(text, "--hw-size"); },
+  cmd->add_option_function<std::string>(
+      "--hw-size", [options](const std::string& text) { options->hw_size = parse_view_size(text, "--hw-size"); },
       "View size WxH the memory figures are reported for (default 1080x1200)");
-  cmd.add_flag("--quick", cli.quick, "Small and fast (CI): 48x40, 4 frames, 1 repeat unless given");
-  cmd.add_flag("--list-knobs", cli.list, "List the knobs and their default ranges, then exit");
-  cmd.add_option_function<std::string>(
+  cmd->add_flag("--quick", cli->quick, "Small and fast (CI): 48x40, 4 frames, 1 repeat unless given");
+  cmd->add_flag("--list-knobs", cli->list, "List the knobs and their default ranges, then exit");
+  cmd->add_option_function<std::string>(
       kShardOption,
-      [&options](const std::string& text) {
+      [options](const std::string& text) {
         try {
-          options.shard = parse_sweep_shard(text);
+          options->shard = parse_sweep_shard(text);
         } catch (const std::invalid_argument& e) {
           throw CLI::ValidationError(kShardOption, e.what());
         }
       },
       "Evaluate only shard K of N of the points (K/N, 1 <= K <= N) and write it as a part directory for --merge");
-  cmd.add_option(kMergeOption, cli.merge,
-                 "Join the part directories of every shard of one sweep into the outputs a single run writes (the "
-                 "sweep's options come from the parts)");
-  cmd.add_option("--out,-o", cli.out, "Output directory (written whole or not at all)")->capture_default_str();
+  cmd->add_option(kMergeOption, cli->merge,
+                  "Join the part directories of every shard of one sweep into the outputs a single run writes (the "
+                  "sweep's options come from the parts)");
+  cmd->add_option("--out,-o", cli->out, "Output directory (written whole or not at all)")->capture_default_str();
 }
 
 // --quick's defaults, for what the command line left unset.
@@ -106,7 +104,7 @@ std::vector<GivenOption> given_options(const CLI::App& cmd, const std::set<std::
 void parse_part_options(const std::vector<GivenOption>& given, SweepCli& cli) {
   CLI::App app;
   CLI::App* cmd = app.add_subcommand("sweep");
-  define_sweep_options(*cmd, cli);
+  define_sweep_options(cmd, &cli);
   std::vector<std::string> args = {"sweep"};
   for (const GivenOption& o : given) {
     if (o.values.empty()) args.push_back(o.name);
@@ -198,15 +196,7 @@ int run(const SweepCli& cli, const std::vector<GivenOption>& part_options) {
 int merge(const CLI::App& cmd, const SweepCli& cli) {
   std::vector<SweepPart> parts;
   for (const std::string& dir : cli.merge) parts.push_back(read_sweep_part(dir));
-  check_sweep_parts(parts);
-  std::error_code ec;
-  const fs::path out = fs::weakly_canonical(cli.out, ec);
-  for (const SweepPart& part : parts) {
-    if (!ec && fs::weakly_canonical(part.dir, ec) == out) {
-      throw std::runtime_error("--merge: the output directory '" + cli.out +
-                               "' is one of the parts; give the merged sweep a directory of its own");
-    }
-  }
+  check_sweep_parts(parts, cli.out);
   SweepCli again;
   parse_part_options(parts.front().options, again);
   again.options.command = sweep_command_text(merged_command_options(cmd, parts.front().options));
@@ -224,7 +214,7 @@ void register_sweep(CLI::App& app, Action& action) {
       "sweep", "Sweep every approximation knob of the fixed-point decoder alone and report error against the "
                "reference vs decode time and memory (default: discs, 270x300, 12 frames, r = 1/2, vive OLED; a few "
                "minutes on two cores)");
-  define_sweep_options(*cmd, *cli);
+  define_sweep_options(cmd, cli.get());
   cmd->callback([cli, cmd, &action] {
     if (!cli->merge.empty()) {
       for (const CLI::Option* opt : cmd->get_options()) {

@@ -31,8 +31,12 @@ nlohmann::json options_json(const std::vector<GivenOption>& options) {
   return list;
 }
 
-// The parts' points of one knob by value.
-using PointsByValue = std::map<int, const SweepPoint*>;
+// The path with symbolic links and dot components resolved, so that two spellings of one directory compare equal.
+fs::path canonical(const fs::path& path) {
+  std::error_code ec;
+  const fs::path resolved = fs::weakly_canonical(path, ec);
+  return ec ? fs::absolute(path).lexically_normal() : resolved;
+}
 
 }  // namespace
 
@@ -153,16 +157,18 @@ SweepPart read_sweep_part(const fs::path& dir) {
   return part;
 }
 
-void check_sweep_parts(const std::vector<SweepPart>& parts) {
+void check_sweep_parts(const std::vector<SweepPart>& parts, const fs::path& out) {
   if (parts.empty()) throw std::runtime_error("--merge needs the part directories of a sharded sweep");
   const SweepPart& first = parts.front();
   std::map<fs::path, const SweepPart*> by_path;
   std::map<int, const SweepPart*> by_index;
   for (const SweepPart& part : parts) {
-    std::error_code ec;
-    const fs::path canonical = fs::weakly_canonical(part.dir, ec);
-    if (!by_path.emplace(ec ? part.dir : canonical, &part).second) {
+    if (!by_path.emplace(canonical(part.dir), &part).second) {
       throw std::runtime_error("--merge: '" + part.dir.string() + "' is given more than once");
+    }
+    if (canonical(part.dir) == canonical(out)) {
+      throw std::runtime_error("--merge: the output directory '" + out.string() +
+                               "' is one of the parts; give the merged sweep a directory of its own");
     }
     if (part.version != first.version) {
       throw std::runtime_error("--merge: parts " + part_name(first) + " and " + part_name(part) +

@@ -47,8 +47,9 @@ std::string sweep_part_text(const SweepResult& result, const std::vector<GivenOp
 SweepPart read_sweep_part(const std::filesystem::path& dir);
 
 // Checks what can be checked before the options are parsed again: one trm version, the same options, one shard count,
-// every shard 1..N exactly once. Throws std::runtime_error naming the parts.
-void check_sweep_parts(const std::vector<SweepPart>& parts);
+// every shard 1..N exactly once, and that the merge's output directory `out` is none of them. Throws
+// std::runtime_error naming the parts.
+void check_sweep_parts(const std::vector<SweepPart>& parts, const std::filesystem::path& out);
 
 // Joins checked parts into a finished result. `options` are the parts' options parsed again (with the merged
 // output's command); throws std::runtime_error when a part's parameters, sequence or points are not those options'.
