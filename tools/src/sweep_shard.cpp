@@ -32,7 +32,7 @@ nlohmann::json options_json(const std::vector<GivenOption>& options) {
 }
 
 // The path with symbolic links and dot components resolved, so that two spellings of one directory compare equal.
-fs::path canonical(const fs::path& path) {
+fs::path resolved_path(const fs::path& path) {
   std::error_code ec;
   const fs::path resolved = fs::weakly_canonical(path, ec);
   return ec ? fs::absolute(path).lexically_normal() : resolved;
@@ -163,10 +163,10 @@ void check_sweep_parts(const std::vector<SweepPart>& parts, const fs::path& out)
   std::map<fs::path, const SweepPart*> by_path;
   std::map<int, const SweepPart*> by_index;
   for (const SweepPart& part : parts) {
-    if (!by_path.emplace(canonical(part.dir), &part).second) {
+    if (!by_path.emplace(resolved_path(part.dir), &part).second) {
       throw std::runtime_error("--merge: '" + part.dir.string() + "' is given more than once");
     }
-    if (canonical(part.dir) == canonical(out)) {
+    if (resolved_path(part.dir) == resolved_path(out)) {
       throw std::runtime_error("--merge: the output directory '" + out.string() +
                                "' is one of the parts; give the merged sweep a directory of its own");
     }
