@@ -28,6 +28,7 @@ packages=(
   python3-dev pybind11-dev python3-pybind11  # the Python module `trm` (tools/python), built for /usr/bin/python3
   python3-numpy python3-pytest               # its arrays and its test suite (tests/python)
   verilator                # the decoder as a DPI-C golden model in an HDL simulation (tests/hdl)
+  slurm-wlm munge          # tools/slurm/sweep.sh's test: a one-node Slurm cluster (slurmctld, slurmd, munged) on localhost
 )
 
 missing=()

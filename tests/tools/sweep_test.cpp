@@ -1,5 +1,6 @@
 // `trm sweep`: the outputs, the base point against a direct comparison of the two decoders, error falling as a
 // precision knob grows, rejected values reported, and bad knob names failing without output.
+#include "csv_reader.hpp"
 #include "pipeline.hpp"
 #include "sweep.hpp"
 #include "trm_process.hpp"
@@ -21,51 +22,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using trm::test::read_csv;
 using trm::test::run_trm;
 using trm::test::ScratchDir;
-
-// One CSV record, honouring double-quoted fields.
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back().push_back('"');
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        out.back().push_back(c);
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else {
-      out.back().push_back(c);
-    }
-  }
-  return out;
-}
-
-// The CSV as maps from column name to field.
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path, std::vector<std::string>* header) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  *header = csv_fields(line);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> fields = csv_fields(line);
-    EXPECT_EQ(fields.size(), header->size()) << line;
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < fields.size() && i < header->size(); ++i) row[(*header)[i]] = fields[i];
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
 
 trm::cli::SweepOptions small_sweep(const std::string& knob, int width, int height, int frames) {
   trm::cli::SweepOptions o;

@@ -1,6 +1,7 @@
 #include "sweep.hpp"
 
 #include "hw_report.hpp"
+#include "vectors.hpp"
 
 #include "trm/metrics.hpp"
 #include "trm/panel.hpp"
@@ -168,6 +169,22 @@ Recording record_reference(const PipelineOptions& pipeline) {
   return rec;
 }
 
+// The recording as the points see it: every view as sent and the reference's drive codes.
+std::uint64_t recording_hash(const Recording& rec) {
+  std::string digests;
+  const auto add = [&digests](const cv::Mat& image) {
+    const cv::Mat continuous = image.isContinuous() ? image : image.clone();
+    const std::uint64_t digest = fnv1a64(std::string(reinterpret_cast<const char*>(continuous.data),
+                                                     continuous.total() * continuous.elemSize()));
+    digests.append(reinterpret_cast<const char*>(&digest), sizeof digest);
+  };
+  for (const RecordedView& view : rec.views) {
+    add(view.sent.codes);
+    add(view.drive_codes);
+  }
+  return fnv1a64(digests);
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
@@ -281,6 +298,13 @@ void SweepOptions::validate() const {
   require_memory("for the pipeline and " + std::to_string(views) + " recorded views",
                  run_bytes_per_pixel(pipeline) + kRecordedViewBytesPerPixel * static_cast<double>(views),
                  cv::Size(pipeline.width, pipeline.height));
+  const std::int64_t points = sweep_point_count(plan_sweep(*this));
+  if (shard.count > points) {
+    throw std::invalid_argument("--shard " + std::to_string(shard.index) + "/" + std::to_string(shard.count) +
+                                ": this sweep has " + std::to_string(points) +
+                                " point(s) (the base and every other value of its knobs), so N must be at most " +
+                                std::to_string(points));
+  }
 }
 
 const SweepPoint* SweepKnobResult::cheapest_meeting() const {
@@ -295,97 +319,50 @@ const SweepPoint* SweepKnobResult::cheapest_meeting() const {
   return best;
 }
 
-SweepResult run_sweep(const SweepOptions& options,
-                      const std::function<void(std::int64_t done, std::int64_t total)>& progress) {
-  options.validate();
-  const Panel& panel = options.pipeline.panel;
+std::vector<SweepPlanKnob> plan_sweep(const SweepOptions& options) {
   const FixedDecoderConfig base = fixed_config_of(options.pipeline);
-  (void)make_decoder("fixed", base);  // an unusable base configuration fails the whole sweep, with its message
-
-  SweepResult result;
-  result.options = options;
-  std::vector<const SweepKnob*> chosen;
+  std::vector<SweepPlanKnob> plan;
   for (const auto& knob : sweep_knobs()) {
     const bool asked = options.knobs.empty() ||
                        std::find(options.knobs.begin(), options.knobs.end(), knob.name) != options.knobs.end();
-    if (asked) chosen.push_back(&knob);
-  }
-  // The values of every chosen knob that applies, base value included (ascending, distinct).
-  std::vector<std::vector<int>> values(chosen.size());
-  std::int64_t decodes = 1;  // the base point
-  for (std::size_t i = 0; i < chosen.size(); ++i) {
-    if (!not_applicable(*chosen[i], panel, options.pipeline.encoder.resample_space).empty()) continue;
-    std::set<int> set(options.values.empty() ? chosen[i]->values.begin() : options.values.begin(),
-                      options.values.empty() ? chosen[i]->values.end() : options.values.end());
-    set.insert(chosen[i]->get(base));
-    values[i].assign(set.begin(), set.end());
-    decodes += static_cast<std::int64_t>(values[i].size()) - 1;
-  }
-
-  const auto start = Clock::now();
-  const Recording rec = record_reference(options.pipeline);
-  result.size = rec.size;
-  result.reduced = rec.reduced;
-  result.views = static_cast<std::int64_t>(rec.views.size());
-  result.reference_seconds_per_frame = rec.reference_seconds / static_cast<double>(result.views);
-  const std::int64_t total = result.views * (1 + decodes * options.repeats);
-  std::int64_t done = result.views;
-  const auto sequence_done = [&] {
-    done += result.views;
-    if (progress) progress(done, total);
-  };
-  if (progress) progress(done, total);
-
-  // One untimed decode of the sequence first, so that the base point is not timed on cold caches.
-  (void)evaluate(base, rec, [&] {
-    SweepOptions once = options;
-    once.repeats = 1;
-    return once;
-  }(), {});
-  result.base = evaluate(base, rec, options, sequence_done);
-  result.base.is_default = true;
-  if (!result.base.ok()) {
-    throw std::runtime_error(std::string("the base configuration failed: ").append(result.base.message));
-  }
-
-  for (std::size_t i = 0; i < chosen.size(); ++i) {
-    const SweepKnob& knob = *chosen[i];
-    SweepKnobResult kr;
-    kr.knob = &knob;
-    kr.default_value = knob.get(base);
-    kr.skipped = not_applicable(knob, panel, options.pipeline.encoder.resample_space);
-    if (!kr.skipped.empty()) {
-      result.knobs.push_back(std::move(kr));
-      continue;
+    if (!asked) continue;
+    SweepPlanKnob k;
+    k.knob = &knob;
+    k.default_value = knob.get(base);
+    k.skipped = not_applicable(knob, options.pipeline.panel, options.pipeline.encoder.resample_space);
+    if (k.skipped.empty()) {
+      std::set<int> set(options.values.empty() ? knob.values.begin() : options.values.begin(),
+                        options.values.empty() ? knob.values.end() : options.values.end());
+      set.insert(k.default_value);
+      k.values.assign(set.begin(), set.end());
     }
-    for (int value : values[i]) {
-      SweepPoint p;
-      if (value == kr.default_value) {
-        p = result.base;
-      } else {
-        FixedDecoderConfig config = base;
-        bool set = true;
-        try {
-          knob.set(config, value);
-        } catch (const std::invalid_argument& e) {
-          p.status = "rejected";
-          p.message = e.what();
-          set = false;
-        }
-        if (set) p = evaluate(config, rec, options, sequence_done);
-        if (!p.ok()) {
-          done += result.views * options.repeats - static_cast<std::int64_t>(p.repeat_seconds_per_frame.size()) *
-                                                       result.views;
-          if (progress) progress(done, total);
-        }
-        p.is_default = false;
-      }
-      p.value = value;
-      if (p.ok()) {
-        p.delta_on_chip_bits = p.on_chip_bits - result.base.on_chip_bits;
-        p.delta_off_chip_bits = p.off_chip_bits - result.base.off_chip_bits;
-      }
-      kr.points.push_back(std::move(p));
+    plan.push_back(std::move(k));
+  }
+  return plan;
+}
+
+std::int64_t sweep_point_count(const std::vector<SweepPlanKnob>& plan) {
+  std::int64_t count = 1;  // the base point
+  for (const SweepPlanKnob& k : plan) {
+    if (!k.values.empty()) count += static_cast<std::int64_t>(k.values.size()) - 1;
+  }
+  return count;
+}
+
+void finish_sweep(SweepResult& result) {
+  const SweepOptions& options = result.options;
+  for (SweepKnobResult& kr : result.knobs) {
+    if (!kr.skipped.empty()) continue;
+    SweepPoint base = result.base;
+    base.value = kr.default_value;
+    base.is_default = true;
+    kr.points.push_back(std::move(base));
+    std::sort(kr.points.begin(), kr.points.end(),
+              [](const SweepPoint& a, const SweepPoint& b) { return a.value < b.value; });
+    for (SweepPoint& p : kr.points) {
+      if (!p.ok()) continue;
+      p.delta_on_chip_bits = p.on_chip_bits - result.base.on_chip_bits;
+      p.delta_off_chip_bits = p.off_chip_bits - result.base.off_chip_bits;
     }
     if (!options.values.empty()) {
       // Asked-for values that all fail leave nothing to report: an error, with the first reason.
@@ -397,13 +374,90 @@ SweepResult run_sweep(const SweepOptions& options,
         else if (!first_failure) first_failure = &p;
       }
       if (!any_asked_ok && first_failure) {
-        throw std::invalid_argument("--values: every value asked for " + knob.name + " was rejected (" +
+        throw std::invalid_argument("--values: every value asked for " + kr.knob->name + " was rejected (" +
                                     std::to_string(first_failure->value) + ": " + first_failure->message + ")");
       }
+    }
+  }
+}
+
+SweepResult run_sweep(const SweepOptions& options,
+                      const std::function<void(std::int64_t done, std::int64_t total)>& progress) {
+  options.validate();
+  const FixedDecoderConfig base = fixed_config_of(options.pipeline);
+  (void)make_decoder("fixed", base);  // an unusable base configuration fails the whole sweep, with its message
+
+  SweepResult result;
+  result.options = options;
+  const std::vector<SweepPlanKnob> plan = plan_sweep(options);
+  const SweepShard& shard = options.shard;
+  // The sequence decodes this shard makes: its points (numbered as SweepShard numbers them) and the base's.
+  std::int64_t decodes = 0;
+  const std::int64_t points = sweep_point_count(plan);
+  for (std::int64_t number = 0; number < points; ++number) decodes += shard.owns(number) ? 1 : 0;
+
+  const auto start = Clock::now();
+  const Recording rec = record_reference(options.pipeline);
+  result.size = rec.size;
+  result.reduced = rec.reduced;
+  result.views = static_cast<std::int64_t>(rec.views.size());
+  result.reference_seconds_per_frame = rec.reference_seconds / static_cast<double>(result.views);
+  result.recording_hash = recording_hash(rec);
+  const std::int64_t total = result.views * (1 + decodes * options.repeats);
+  std::int64_t done = result.views;
+  const auto sequence_done = [&] {
+    done += result.views;
+    if (progress) progress(done, total);
+  };
+  if (progress) progress(done, total);
+
+  // One untimed decode of the sequence first, so that the first timed point is not timed on cold caches.
+  (void)evaluate(base, rec, [&] {
+    SweepOptions once = options;
+    once.repeats = 1;
+    return once;
+  }(), {});
+  if (shard.owns(0)) {
+    result.base = evaluate(base, rec, options, sequence_done);
+    result.base.is_default = true;
+    if (!result.base.ok()) {
+      throw std::runtime_error(std::string("the base configuration failed: ").append(result.base.message));
+    }
+  }
+
+  std::int64_t number = 0;  // the base point's
+  for (const SweepPlanKnob& planned : plan) {
+    const SweepKnob& knob = *planned.knob;
+    SweepKnobResult kr;
+    kr.knob = &knob;
+    kr.default_value = planned.default_value;
+    kr.skipped = planned.skipped;
+    for (int value : planned.values) {
+      if (value == kr.default_value || !shard.owns(++number)) continue;
+      SweepPoint p;
+      FixedDecoderConfig config = base;
+      bool set = true;
+      try {
+        knob.set(config, value);
+      } catch (const std::invalid_argument& e) {
+        p.status = "rejected";
+        p.message = e.what();
+        set = false;
+      }
+      if (set) p = evaluate(config, rec, options, sequence_done);
+      if (!p.ok()) {
+        done += result.views * options.repeats -
+                static_cast<std::int64_t>(p.repeat_seconds_per_frame.size()) * result.views;
+        if (progress) progress(done, total);
+      }
+      p.is_default = false;
+      p.value = value;
+      kr.points.push_back(std::move(p));
     }
     result.knobs.push_back(std::move(kr));
   }
   result.wall_seconds = seconds_since(start);
+  if (shard.whole()) finish_sweep(result);
   return result;
 }
 

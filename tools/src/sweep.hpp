@@ -42,6 +42,15 @@ const std::vector<SweepKnob>& sweep_knobs();
 // The knob called name, or nullptr.
 const SweepKnob* find_sweep_knob(const std::string& name);
 
+// Which part of the sweep's points one process evaluates (`--shard K/N`, sweep_shard.hpp): the points are numbered
+// in sweep order, the base point first, and shard K takes those whose number is K - 1 modulo N.
+struct SweepShard {
+  int index = 1;  // K, 1-based
+  int count = 1;  // N
+  bool whole() const { return count == 1; }
+  bool owns(std::int64_t point_number) const { return point_number % count == index - 1; }
+};
+
 struct SweepOptions {
   PipelineOptions pipeline;           // scene / input, size, frames, r, panel, bits, ...; impl is ignored
   std::vector<std::string> knobs;     // empty: every knob the panel uses
@@ -49,9 +58,11 @@ struct SweepOptions {
   int repeats = 5;                    // decode time: median per view over this many decodes of the sequence
   cv::Size hw_size{1080, 1200};       // view size the memory figures are reported for
   std::string command;                // the command line that reproduces the run (for the reports)
+  SweepShard shard;                   // the whole sweep unless --shard
 
   // Throws std::invalid_argument with one clear message: unknown knob (listing the known ones), --values without
-  // exactly one knob, repeats < 1, and everything PipelineOptions::validate() rejects.
+  // exactly one knob, repeats < 1, a shard count above the number of points, and everything
+  // PipelineOptions::validate() rejects.
   void validate() const;
 };
 
@@ -93,6 +104,14 @@ struct SweepPoint {
   }
 };
 
+// A part file holds its points as JSON (sweep_shard.cpp); every field is carried, so a merged sweep writes what a
+// single run writes.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SweepPoint, value, is_default, status, message, codes, differing,
+                                   identical_percent, max_lsb, mean_lsb, rms_lsb, linear_max, linear_rms,
+                                   drive_max_lsb, residual_saturated, residual_rounded, seconds_per_frame,
+                                   min_seconds_per_frame, repeat_seconds_per_frame, setup_seconds, on_chip_bits,
+                                   off_chip_bits, delta_on_chip_bits, delta_off_chip_bits, residual_format)
+
 struct SweepKnobResult {
   const SweepKnob* knob = nullptr;
   int default_value = 0;
@@ -112,10 +131,31 @@ struct SweepResult {
   SweepPoint base;                    // every knob at its base value
   std::vector<SweepKnobResult> knobs;
   double wall_seconds = 0.0;
+  std::uint64_t recording_hash = 0;   // of the sent codes and the reference's drive codes: parts must agree on it
 };
 
+// The sweep's plan: every chosen knob in pipeline order, why it is skipped (empty: it applies) and the values it
+// takes, ascending, base value included.
+struct SweepPlanKnob {
+  const SweepKnob* knob = nullptr;
+  int default_value = 0;
+  std::string skipped;
+  std::vector<int> values;
+};
+std::vector<SweepPlanKnob> plan_sweep(const SweepOptions& options);
+// The points of a plan, numbered as SweepShard numbers them: the base point (0), then every value other than the
+// base of every knob that applies, in plan order.
+std::int64_t sweep_point_count(const std::vector<SweepPlanKnob>& plan);
+
+// The last step of a sweep, of a whole run and of a merge of its parts alike: adds the base point as every knob's
+// base value, orders the points by value, sets the memory change against the base, and throws
+// std::invalid_argument when every value asked for with --values was rejected.
+void finish_sweep(SweepResult& result);
+
 // Encodes the sequence once, decodes it once with the reference, then once per sweep point (repeats times) with
-// FixedStreamingDecoder. progress(done, total) is called after every decode of the sequence.
+// FixedStreamingDecoder. progress(done, total) is called after every decode of the sequence. With a shard other
+// than the whole, only its points are decoded and the result is left unfinished: the base point is there only
+// in the shard that owns it, and no knob holds its base value (finish_sweep() adds them once the parts are merged).
 SweepResult run_sweep(const SweepOptions& options,
                       const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
 

@@ -213,23 +213,27 @@ std::string sweep_markdown(const SweepResult& r) {
   return s.str();
 }
 
-Json sweep_json(const SweepResult& r) {
+Json sweep_parameters_json(const SweepResult& r) {
   const auto& o = r.options;
   const auto& po = o.pipeline;
+  return {{"source", source_text(o)},
+          {"size", {r.size.width, r.size.height}},
+          {"reduced_size", {r.reduced.width, r.reduced.height}},
+          {"views", r.views},
+          {"encoder", encoder_json(po.encoder)},
+          {"output_bits", po.output_bits},
+          {"sensitivity", po.sensitivity},
+          {"panel", po.panel},
+          {"seed", po.seed},
+          {"repeats", o.repeats},
+          {"hw_size", {o.hw_size.width, o.hw_size.height}}};
+}
+
+Json sweep_json(const SweepResult& r) {
   Json j;
   j["tool"] = "trm sweep";
-  j["command"] = o.command;
-  j["parameters"] = {{"source", source_text(o)},
-                     {"size", {r.size.width, r.size.height}},
-                     {"reduced_size", {r.reduced.width, r.reduced.height}},
-                     {"views", r.views},
-                     {"encoder", encoder_json(po.encoder)},
-                     {"output_bits", po.output_bits},
-                     {"sensitivity", po.sensitivity},
-                     {"panel", po.panel},
-                     {"seed", po.seed},
-                     {"repeats", o.repeats},
-                     {"hw_size", {o.hw_size.width, o.hw_size.height}}};
+  j["command"] = r.options.command;
+  j["parameters"] = sweep_parameters_json(r);
   j["criterion"] = {{"identical_percent_at_least", kReferenceAgreementCriterion.min_identical_percent()},
                     {"max_lsb_at_most", kReferenceAgreementCriterion.max_lsb}};
   j["reference_seconds_per_frame"] = r.reference_seconds_per_frame;

@@ -18,6 +18,8 @@ std::string sweep_csv(const SweepResult& result);
 std::string sweep_markdown(const SweepResult& result);
 // report.json: parameters, base configuration and every point.
 Json sweep_json(const SweepResult& result);
+// Its "parameters" block: the sequence and configuration every point was decoded with.
+Json sweep_parameters_json(const SweepResult& result);
 // sweep_<knob>.png: error against knob value, against memory and against decode time.
 void write_sweep_plot(const std::filesystem::path& path, const SweepResult& result, const SweepKnobResult& knob);
 // The short table printed to stdout: per knob, the base point and the cheapest point meeting the criterion.
