@@ -297,6 +297,18 @@ void LcdPanel::validate(const std::string& what) const {
     }
     if (!(2.0 * (2.0 * p1 + p2) * v + 2.0 * p3 > 0.0)) fail("the held LCD merge M(v, v) must be increasing on [0, 1]");
   }
+  if (lc_second_order) {
+    try {
+      LcSecondOrder(*lc_second_order, 1.0);  // the model's own ranges, named
+    } catch (const std::invalid_argument& e) {
+      fail(std::string("LCD lc_second_order: ") + e.what());
+    }
+    if (!(lc_second_order->damping_ratio >= kMinPanelDampingRatio)) {
+      fail("LCD lc_second_order damping_ratio " + number_text(lc_second_order->damping_ratio) + " must be >= " +
+           number_text(kMinPanelDampingRatio) + ": an underdamped crystal overshoots, and a panel's light cannot go "
+           "below black");
+    }
+  }
 }
 
 void Panel::validate(const std::string& what) const {
@@ -415,6 +427,10 @@ void write_panel(Json& out, const Panel& panel) {
   const LcdPanel& lcd = panel.lcd;
   out = {{"kind", "lcd"}, {"name", panel.name}, {"p1", lcd.p1}, {"p2", lcd.p2},
          {"p3", lcd.p3},  {"p4", lcd.p4},       {"gamma", lcd.gamma}};
+  if (lcd.lc_second_order) {
+    out["lc_second_order"] = {{"tau_s", lcd.lc_second_order->tau_s},
+                              {"damping_ratio", lcd.lc_second_order->damping_ratio}};
+  }
 }
 
 [[noreturn]] void reject_json(const std::string& why) { throw std::invalid_argument("panel JSON: " + why); }
@@ -457,6 +473,16 @@ void read_panel(const Json& in, Panel& panel) {
     out.lcd.p3 = number_field(in, "p3");
     out.lcd.p4 = number_field(in, "p4");
     out.lcd.gamma = number_field(in, "gamma");
+    if (const auto lc = in.find("lc_second_order"); lc != in.end()) {
+      constexpr const char* kTakes = " (it takes {\"tau_s\": s, \"damping_ratio\": zeta})";
+      if (!lc->is_object()) reject_json("\"lc_second_order\" must be an object, got " + lc->dump() + kTakes);
+      for (const auto& item : lc->items()) {
+        if (item.key() != "tau_s" && item.key() != "damping_ratio") {
+          reject_json("\"lc_second_order\" has an unknown field \"" + item.key() + "\"" + kTakes);
+        }
+      }
+      out.lcd.lc_second_order = LcSecondOrderParams{number_field(*lc, "tau_s"), number_field(*lc, "damping_ratio")};
+    }
   } else {
     reject_json("\"kind\" must be \"oled\" or \"lcd\", got " + kind.dump());
   }

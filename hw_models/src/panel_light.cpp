@@ -48,11 +48,16 @@ PanelLight::PanelLight(const PanelLightConfig& config) : config_(config) {
   if (!(std::isfinite(config.lc_tau_s) && config.lc_tau_s >= 0.0)) {
     reject(kWhere, "lc_tau_s", "must be finite and >= 0, got " + number_text(config.lc_tau_s));
   }
-  if (config.lc_response && config.lc_tau_s != 0.0) {
-    reject(kWhere, "lc_tau_s", "must be 0 when lc_response is set (one LC model), got " + number_text(config.lc_tau_s));
+  if ((config.lc_response || config.lc_second_order) && config.lc_tau_s != 0.0) {
+    reject(kWhere, "lc_tau_s",
+           "must be 0 when lc_response or lc_second_order is set (one LC model), got " + number_text(config.lc_tau_s));
+  }
+  if (config.lc_response && config.lc_second_order) {
+    reject(kWhere, "lc_second_order", "cannot be set together with lc_response (one LC model)");
   }
   period_ = 1.0 / config.refresh_hz;
   if (config.lc_response) response_.emplace(*config.lc_response, period_);
+  if (config.lc_second_order) second_order_.emplace(*config.lc_second_order, period_);
   window_begin_ = config.window_start * period_;
   window_end_ = std::min(period_, (config.window_start + config.duty) * period_);
   decay_ = config.lc_tau_s > 0.0 ? std::exp(-period_ / config.lc_tau_s) : 0.0;
@@ -71,22 +76,39 @@ LcSegment PanelLight::segment(double previous_state, double level) const {
   return {level, config_.lc_tau_s};
 }
 
+double PanelLight::level_at(double t, const LcMotion& previous_state, double level) const {
+  if (!second_order_) return level_at(t, previous_state.level, level);
+  if (!(t >= window_begin_ && t < window_end_)) return 0.0;
+  return second_order_->advance(previous_state, level, t).level / config_.duty;
+}
+
 double PanelLight::level_at(double t, double previous_state, double level) const {
+  if (second_order_) return level_at(t, LcMotion{previous_state, 0.0}, level);
   if (!(t >= window_begin_ && t < window_end_)) return 0.0;
   const LcSegment seg = segment(previous_state, level);
   const double state = seg.tau_s > 0.0 ? seg.drive + (previous_state - seg.drive) * std::exp(-t / seg.tau_s) : seg.drive;
   return state / config_.duty;
 }
 
-LightWeights PanelLight::weights(double t0, double t1) const { return weights(t0, t1, config_.lc_tau_s); }
-
-LightWeights PanelLight::weights(double t0, double t1, double tau) const {
+std::pair<double, double> PanelLight::lit_part(double t0, double t1) const {
   constexpr const char* kWhere = "PanelLight::weights";
   if (!(t0 >= 0.0 && t0 <= period_)) reject(kWhere, "t0", "must be in [0, T], got " + number_text(t0));
   if (!(t1 >= t0 && t1 <= period_)) reject(kWhere, "t1", "must be in [t0, T], got " + number_text(t1));
-  if (!(tau >= 0.0)) reject(kWhere, "tau_s", "must be >= 0, got " + number_text(tau));
-  const double u0 = std::max(t0, window_begin_);
-  const double u1 = std::min(t1, window_end_);
+  return {std::max(t0, window_begin_), std::min(t1, window_end_)};
+}
+
+LightWeights PanelLight::weights(double t0, double t1) const {
+  if (!second_order_) return weights(t0, t1, config_.lc_tau_s);
+  const auto [u0, u1] = lit_part(t0, t1);
+  if (!(u1 > u0)) return {};
+  const LcMotionWeights w = second_order_->weights(u0, u1);
+  const double duty = config_.duty;
+  return {w.level / duty, w.previous / duty, w.previous_rate / duty};
+}
+
+LightWeights PanelLight::weights(double t0, double t1, double tau) const {
+  const auto [u0, u1] = lit_part(t0, t1);
+  if (!(tau >= 0.0)) reject("PanelLight::weights", "tau_s", "must be >= 0, got " + number_text(tau));
   if (!(u1 > u0)) return {};
   const double span = u1 - u0;
   const double duty = config_.duty;
@@ -100,13 +122,28 @@ LightWeights PanelLight::weights(double t0, double t1, double tau) const {
   return {level / duty, previous / duty};
 }
 
+double PanelLight::integral(double t0, double t1, const LcMotion& previous_state, double level) const {
+  if (!second_order_) return integral(t0, t1, previous_state.level, level);
+  const LightWeights w = weights(t0, t1);
+  return w.level * level + w.previous * previous_state.level + w.previous_rate * previous_state.rate_per_s;
+}
+
 double PanelLight::integral(double t0, double t1, double previous_state, double level) const {
+  if (second_order_) return integral(t0, t1, LcMotion{previous_state, 0.0}, level);
   const LcSegment seg = segment(previous_state, level);
   const LightWeights w = weights(t0, t1, seg.tau_s);
   return w.level * seg.drive + w.previous * previous_state;
 }
 
+LcMotion PanelLight::end_state(const LcMotion& previous_state, double level) const {
+  if (second_order_) return second_order_->end_of_frame(previous_state, level);
+  return {end_state(previous_state.level, level), 0.0};
+}
+
 double PanelLight::end_state(double previous_state, double level) const {
+  if (second_order_) {
+    throw std::logic_error("PanelLight::end_state: the second-order LC's state has a rate; pass an LcMotion");
+  }
   if (response_) return response_->advance(previous_state, response_->drive_for(previous_state, level), period_);
   return level + (previous_state - level) * decay_;
 }
@@ -127,7 +164,11 @@ PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOp
     }
     config.window_start = options.strobe_start < 0.0 ? 1.0 - options.strobe_duty : options.strobe_start;
     config.lc_tau_s = 0.0;
-    config.lc_response = options.lc_response;
+    if (panel.lcd.lc_second_order) {
+      config.lc_second_order = panel.lcd.lc_second_order;
+    } else {
+      config.lc_response = options.lc_response;
+    }
   }
   return PanelLight(config);
 }

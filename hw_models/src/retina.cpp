@@ -148,6 +148,9 @@ void line_pass(const std::vector<const double*>& frames, Line line, const double
   // The level-dependent response gives every pixel its own segment (drive, τ): its light over a step is summed per
   // pixel first, then shifted once.
   const bool per_pixel = light.lc_response().has_value();
+  // The second-order LC also carries each pixel's rate (from rest at the start), with weights shared by all pixels.
+  const bool second_order = light.lc_second_order().has_value();
+  std::vector<double> rate(second_order ? samples : 0, 0.0);
   std::vector<LcSegment> segments(per_pixel ? samples : 0);
   std::vector<double> step_light(per_pixel ? samples : 0);
   const double begin = steps == Steps::Lit ? light.window_begin_s() : 0.0;
@@ -172,8 +175,15 @@ void line_pass(const std::vector<const double*>& frames, Line line, const double
       const LightWeights w = light.weights(t0, t1);
       add_shifted(frames[f], line, shift, w.level * scale, dst);
       if (has_history) add_shifted(state.data(), line, shift, w.previous * scale, dst);
+      if (second_order) add_shifted(rate.data(), line, shift, w.previous_rate * scale, dst);
     }
-    if (has_history) {
+    if (second_order) {
+      for (std::size_t i = 0; i < samples; ++i) {
+        const LcMotion next = light.end_state(LcMotion{state[i], rate[i]}, frames[f][i]);
+        state[i] = next.level;
+        rate[i] = next.rate_per_s;
+      }
+    } else if (has_history) {
       for (std::size_t i = 0; i < samples; ++i) state[i] = light.end_state(state[i], frames[f][i]);
     }
   }

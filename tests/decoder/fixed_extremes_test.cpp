@@ -672,6 +672,52 @@ TEST(FixedExtremes, LcdDegenerateAndCustomMerges) {
   expect_case(encode_sequence(test::noise_images(16, 12, 4, 37), link), ten_bit, "noise custom lcd 10b contributed");
 }
 
+TEST(FixedExtremes, LcdNoRootWithANearlyLinearMerge) {
+  // p1 -> 0 with p2 = -2 p1, p3 = 1/2, p4 = 0: M(v, v_prev) = p1 (v - v_prev)^2 + (v + v_prev) / 2, the quadratic
+  // degenerating to a linear solve. Black, then white on a full frame: the target ((1 + 0) / 2)^(1/gamma) = 0.730
+  // lies above the brightest merge M(1, 0) = 1/2 + p1, so no drive in [0, 1] reaches it: every sample clamps to
+  // code 255 and the full frame's shortfall 1 - 2 (1/2 + p1)^gamma goes into rho, which the static reduced frame
+  // after it adds to its alpha = 1: clamped there, the whole shortfall is dropped and counted. Coefficients below half an LSB of the fixed decoder's sQ7.f (f = linear_frac_bits)
+  // round to 0, so those merges give the very bits of p1 = 0.
+  const EncoderConfig link = link_config(0.5);
+  const std::vector<LinkFrame> frames =
+      encode_sequence({grey(12, 10, 0.0), grey(12, 10, 0.0), grey(12, 10, 1.0), grey(12, 10, 1.0),
+                       grey(12, 10, 1.0), grey(12, 10, 1.0)}, link);
+  for (const LcdHistory history : {LcdHistory::Wanted, LcdHistory::Contributed}) {
+    std::vector<cv::Mat> linear_codes;  // the p1 = 0 run's drive codes
+    for (const double p1 : {0.0, 1e-9, -1e-9, 1e-12, -1e-15}) {
+      const std::string panel = "lcd:" + std::to_string(p1) + "," + std::to_string(-2.0 * p1) + ",0.5,0,2.2";
+      FixedDecoderConfig config = fixed_config(link, "lcd:0,0,0.5,0,2.2");
+      config.decoder.panel.lcd.p1 = p1;  // exactly, not through the text's six decimals
+      config.decoder.panel.lcd.p2 = -2.0 * p1;
+      config.decoder.lcd_history = history;
+      const std::string what = "p1 = " + testing::PrintToString(p1) + (history == LcdHistory::Wanted ? " wanted" : " contributed");
+      std::vector<DecodedFrame> shown;
+      const CaseRun run = expect_case(frames, config, what,
+                                      [&](const LinkFrame&, const DecodedFrame& fixed, const FixedStageCounts&,
+                                          const DecodedFrame*) { shown.push_back(fixed); });
+      ASSERT_EQ(shown.size(), frames.size()) << what;
+      const DecodedFrame& full = shown[2];
+      const DecodedFrame& reduced = shown[3];
+      EXPECT_EQ(full.stats.lcd_unreachable_fraction, 1.0) << what;
+      EXPECT_EQ(full.drive_codes.at<cv::Vec3w>(4, 6)[0], 255) << what;
+      const double shortfall = 1.0 - 2.0 * std::pow(0.5 + p1, 2.2);
+      EXPECT_NEAR(full.stats.residual_max_abs, shortfall, 1e-6) << what;
+      EXPECT_TRUE(reduced.stats.residual_applied) << what;
+      EXPECT_EQ(reduced.wanted_linear.at<cv::Vec3d>(4, 6)[0], 1.0) << what;
+      EXPECT_NEAR(reduced.stats.dropped_sum, 12 * 10 * 3 * shortfall, 1e-3) << what;
+      EXPECT_GT(run.totals.lcd_unreachable, 0u) << what;
+      if (p1 == 0.0) {
+        for (const DecodedFrame& d : shown) linear_codes.push_back(d.drive_codes);
+      } else if (2.0 * std::abs(p1) < std::ldexp(1.0, -(config.linear_frac_bits + 1))) {
+        for (std::size_t t = 0; t < shown.size(); ++t) {
+          EXPECT_TRUE(test::identical(shown[t].drive_codes, linear_codes[t])) << what << " t=" << t;
+        }
+      }
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Motion sensitivity s -> 0 and s -> inf.
 

@@ -8,7 +8,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <stdexcept>
@@ -135,6 +137,54 @@ TEST(LcResponse, StiffCrystalReachesTheLevelWhereExplicitEulerBlowsUp) {
   const cv::Mat instant = retinal_row(frames, PanelLight(PanelLightConfig{90.0, 1.0, 0.0, 0.0}), viewer, 30.0);
   EXPECT_TRUE(cv::checkRange(stiff));
   EXPECT_LT(cv::norm(stiff, instant, cv::NORM_INF), 1e-6);
+}
+
+TEST(LcResponse, ExactForStepsFromAMillionthToAMillionTimeConstants) {
+  // dt/τ from 1e-6 to 1e6 (τ from a million frames down to a millionth of one): the frame's end state, its light
+  // and the light of a part of it against the closed form in long double, for the constant τ and for the
+  // level-dependent response (τ_off scaled, τ_on(p) by Jakeman–Raynes). Errors in units of the step and of T.
+  double worst_state = 0.0, worst_light = 0.0;
+  const std::vector<std::pair<double, double>> steps = {{0.0, 1.0}, {1.0, 0.0}, {0.3, 0.75}, {0.8, 0.05}};
+  for (int decade = -6; decade <= 6; ++decade) {
+    const double dt_over_tau = std::pow(10.0, decade);
+    LcResponseParams params;
+    params.tau_off_s = kPeriod / dt_over_tau;
+    PanelLightConfig constant;
+    constant.refresh_hz = kRefresh;
+    constant.lc_tau_s = kPeriod / dt_over_tau;
+    for (const PanelLight& light : {PanelLight(constant), lc_light(params)}) {
+      const bool level_dependent = light.lc_response().has_value();
+      for (const auto& [x0, level] : steps) {
+        const long double tau =
+            !level_dependent ? constant.lc_tau_s : level > x0 ? jakeman_raynes_rise_tau(params, level) : params.tau_off_s;
+        const auto state_at = [&](long double t) { return level + (x0 - level) * std::exp(-t / tau); };
+        const auto light_over = [&](long double t0, long double t1) {
+          // e^{−t0/τ} − e^{−t1/τ} through expm1: the plain difference loses the digits of a slow crystal.
+          return level * (t1 - t0) + (x0 - level) * tau * std::exp(-t0 / tau) * -std::expm1(-(t1 - t0) / tau);
+        };
+        SCOPED_TRACE(testing::Message() << "dt/tau " << dt_over_tau << (level_dependent ? " level-dependent " : " ")
+                                        << x0 << " -> " << level);
+        const double state_error = std::abs(light.end_state(x0, level) - static_cast<double>(state_at(kPeriod)));
+        const double frame_error =
+            std::abs(light.integral(0.0, kPeriod, x0, level) - static_cast<double>(light_over(0.0L, kPeriod))) / kPeriod;
+        const double part_error = std::abs(light.integral(0.3 * kPeriod, 0.35 * kPeriod, x0, level) -
+                                           static_cast<double>(light_over(0.3L * kPeriod, 0.35L * kPeriod))) / kPeriod;
+        EXPECT_LT(state_error, 1e-15);
+        EXPECT_LT(frame_error, 1e-15);
+        EXPECT_LT(part_error, 1e-15);
+        // First order: between the start and the level at every time, never beyond.
+        for (int i = 0; i <= 16; ++i) {
+          const double at = light.level_at(kPeriod * i / 17.0, x0, level);
+          EXPECT_GE(at, std::min(x0, level) - 1e-16);
+          EXPECT_LE(at, std::max(x0, level) + 1e-16);
+        }
+        worst_state = std::max(worst_state, state_error);
+        worst_light = std::max({worst_light, frame_error, part_error});
+      }
+    }
+  }
+  std::printf("[ LC 1st order ] dt/tau 1e-6..1e6: max |x - x_exact| %.2e, max |light error| / T %.2e\n", worst_state,
+              worst_light);
 }
 
 TEST(LcResponse, RiseIsFasterAtHigherDrive) {

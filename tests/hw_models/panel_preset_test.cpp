@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "trm/panel.hpp"
+#include "trm/panel_light.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -9,6 +10,8 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 #include <unistd.h>
 
 namespace trm {
@@ -66,6 +69,42 @@ TEST(PanelPreset, BadFilesAreRejectedWithTheFileAndTheReason) {
   EXPECT_NE(rejection(std::string("lcd:.\0\0aP.json", 15)).find("invalid panel"), std::string::npos);  // a NUL
   EXPECT_NE(rejection("lcd:/dev/null.json").find("cannot open"), std::string::npos);
   for (const auto& path : {garbage, oled_file, falling, missing}) std::filesystem::remove(path);
+}
+
+TEST(PanelPreset, SecondOrderCrystalIsSelectedByThePresetAndValidated) {
+  // Without the field the JSON is what it always was; with it, it round-trips and the eye model's light uses it.
+  const Panel plain = parse_panel("lcd");
+  EXPECT_FALSE(nlohmann::json(plain).contains("lc_second_order"));
+  EXPECT_FALSE(panel_light(plain, 90.0).lc_second_order().has_value());
+  Panel panel = plain;
+  panel.lcd.lc_second_order = LcSecondOrderParams{0.0012, 1.4};
+  const std::filesystem::path path = write_file("second_order.json", nlohmann::json(panel).dump(2));
+  const Panel read = parse_panel("lcd:" + path.string());
+  EXPECT_EQ(read, panel);
+  EXPECT_NE(read, plain);
+  const PanelLight light = panel_light(read, 90.0);
+  ASSERT_TRUE(light.lc_second_order().has_value());
+  EXPECT_EQ(light.lc_second_order()->params(), (LcSecondOrderParams{0.0012, 1.4}));
+  EXPECT_FALSE(light.lc_response().has_value());
+  std::filesystem::remove(path);
+
+  const std::string head = R"({"kind": "lcd", "name": "x", "p1": -0.1, "p2": 0.2, "p3": 0.5, "p4": 0, "gamma": 2.2, )";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"("lc_second_order": {"tau_s": 0.002, "damping_ratio": 0.5}})", "must be >= 1"},
+      {R"("lc_second_order": {"tau_s": 0, "damping_ratio": 1}})", "'tau_s'"},
+      {R"("lc_second_order": {"tau_s": -1e-3, "damping_ratio": 1}})", "'tau_s'"},
+      {R"("lc_second_order": {"tau_s": 0.002}})", "missing \"damping_ratio\""},
+      {R"("lc_second_order": {"tau_s": "2ms", "damping_ratio": 1}})", "\"tau_s\" must be a number"},
+      {R"("lc_second_order": {"tau_s": 0.002, "damping_ratio": 1, "mass": 3}})", "unknown field \"mass\""},
+      {R"("lc_second_order": 0.002})", "must be an object"},
+  };
+  for (const auto& [tail, needle] : bad) {
+    const std::filesystem::path file = write_file("bad_second_order.json", head + tail);
+    const std::string message = rejection("lcd:" + file.string());
+    EXPECT_NE(message.find(needle), std::string::npos) << tail << ": " << message;
+    EXPECT_NE(message.find("panel JSON"), std::string::npos) << message;
+    std::filesystem::remove(file);
+  }
 }
 
 }  // namespace

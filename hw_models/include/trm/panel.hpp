@@ -12,8 +12,11 @@
 #include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
+#include "trm/lc_second_order.hpp"
+
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +48,9 @@ struct OledPanel {
 struct LcdPanel {
   double p1 = -0.1, p2 = 0.2, p3 = 0.5, p4 = 0.0;  // defaults satisfy M(v, v) = v (p4 = 0, p3 = 1/2, p2 = -2 p1)
   double gamma = 2.2;
+  // The liquid crystal of the eye model's light (panel_light.hpp): unset, the level-dependent first-order response;
+  // set, the second-order system (damping_ratio >= kMinPanelDampingRatio). The drive (Eq. 7) does not depend on it.
+  std::optional<LcSecondOrderParams> lc_second_order;
 
   double merge(double v_t, double v_prev) const;
   // Solves M(v, v_prev) = m for v in [0, 1] with the stable quadratic root form (linear solve when
@@ -143,7 +149,8 @@ void validate_panel(const Panel& panel, const std::string& what);
 Panel parse_panel(const std::string& spec);
 
 // The panel as JSON, every parameter of its kind: {"kind": "oled", "name", "gamma": [R, G, B], "duty"} or
-// {"kind": "lcd", "name", "p1", "p2", "p3", "p4", "gamma"}. The one writer and the one reader of a panel, for both
+// {"kind": "lcd", "name", "p1", "p2", "p3", "p4", "gamma"}, and with a second-order liquid crystal
+// "lc_second_order": {"tau_s", "damping_ratio"} (absent without one). The one writer and the one reader of a panel, for both
 // JSON flavours the reports use (one body each).
 void to_json(nlohmann::json& out, const Panel& panel);
 void to_json(nlohmann::ordered_json& out, const Panel& panel);

@@ -20,19 +20,24 @@
 // The liquid crystal relaxes toward L for the whole frame, lit or not, and a frame ends at end_state(s0, L), where
 // the next frame starts. τ is either one constant (lc_tau_s) or, for LCD panels, the level-dependent response of
 // lc_response.hpp (rise τ_on(p) faster at higher drive, fall τ_off, optional overdrive): then each frame's segment
-// relaxes toward the drive p the panel applies (L, or the overdriven level) with τ(s0, p), per pixel. Every value is the closed form (the exponential update, not a time step of the ODE), so it
-// is exact and stable for any τ >= 0: τ far below T reaches L without overshoot, τ far above T barely moves.
+// relaxes toward the drive p the panel applies (L, or the overdriven level) with τ(s0, p), per pixel. Or the LC is
+// the second-order system of lc_second_order.hpp (an LCD preset's "lc_second_order"): its state is the level and
+// its rate (LcMotion), and the light of a part of a frame is linear in L, s0 and the rate s0' with weights shared by
+// every pixel. Every value is the closed form (the exponential or matrix-exponential update, not a time step of the
+// ODE), so it is exact and stable for any τ >= 0: τ far below T reaches L without overshoot, τ far above T barely
+// moves.
 //
 // Rolling scan-out: row y of H starts its frames y / H · T after row 0 (the scan reaches it then); global scan-out
 // starts every row together. Times passed to level_at and integral are since the row's own frame start.
 #pragma once
 
 #include "trm/lc_response.hpp"
+#include "trm/lc_second_order.hpp"
 #include "trm/panel.hpp"
 
 #include <optional>
-
 #include <string>
+#include <utility>
 
 namespace trm {
 
@@ -46,6 +51,8 @@ struct PanelLightConfig {
   ScanOut scan_out = ScanOut::Global;
   // The level-dependent LC response; set, it replaces lc_tau_s (which must then be 0).
   std::optional<LcResponseParams> lc_response = std::nullopt;
+  // The second-order LC; set, it replaces both (lc_tau_s must be 0 and lc_response unset).
+  std::optional<LcSecondOrderParams> lc_second_order = std::nullopt;
 };
 
 // Low persistence on the Vive (paper Sec. 2.2, Fig. 2c, measured with a 9 kHz sensor: "the display remains black for
@@ -69,16 +76,19 @@ struct PanelLightOptions {
   double strobe_start = -1.0;
 };
 
-// ∫ light dt over an interval = level · L + previous · s0 (seconds × light).
+// ∫ light dt over an interval = level · L + previous · s0 + previous_rate · s0' (seconds × light; s0' the
+// second-order LC's rate, whose weight is 0 for the first-order models).
 struct LightWeights {
   double level = 0.0;
   double previous = 0.0;
+  double previous_rate = 0.0;
 };
 
 class PanelLight {
  public:
   // Throws std::invalid_argument naming the field: refresh_hz finite and > 0, duty in (0, 1], window_start in
-  // [0, 1 − duty], lc_tau_s finite and >= 0 (0 with lc_response), lc_response's fields (LcResponse).
+  // [0, 1 − duty], lc_tau_s finite and >= 0 (0 with lc_response or lc_second_order), lc_response's fields
+  // (LcResponse), lc_second_order's (LcSecondOrder; not with lc_response).
   explicit PanelLight(const PanelLightConfig& config);
 
   const PanelLightConfig& config() const { return config_; }
@@ -91,23 +101,30 @@ class PanelLight {
   double row_delay_s(int y, int rows) const;
   // The LC response: its state depends on the previous frame (lc_tau_s > 0 or lc_response), and whether its τ
   // depends on the transition (lc_response: the weights differ per pixel, take them from segment()).
-  bool has_lc_state() const { return config_.lc_tau_s > 0.0 || response_.has_value(); }
+  bool has_lc_state() const { return config_.lc_tau_s > 0.0 || response_.has_value() || second_order_.has_value(); }
   const std::optional<LcResponse>& lc_response() const { return response_; }
+  // The second-order LC: the state is an LcMotion, and the LcMotion overloads below are the ones to use (the scalar
+  // ones take the state at rest, and end_state(double, double) throws std::logic_error, as it would drop the rate).
+  const std::optional<LcSecondOrder>& lc_second_order() const { return second_order_; }
   // The frame's segment from state s0 for wanted level L: the drive the LC relaxes toward and τ (constant τ: L, τ).
   LcSegment segment(double previous_state, double level) const;
 
   // light(t) for t in [0, T] since the frame start, after state s0 (`previous_state`), driving `level` (through
   // segment(): with overdrive the LC relaxes toward the overdriven level).
   double level_at(double t, double previous_state, double level) const;
+  double level_at(double t, const LcMotion& previous_state, double level) const;
   // ∫_{t0}^{t1} light dt in closed form, 0 <= t0 <= t1 <= T (throws std::invalid_argument naming `t0` or `t1`):
   // previous = τ e^{−u0/τ} (1 − e^{−Δ/τ}) / duty and level = Δ / duty − previous over the lit part [u0, u0 + Δ] of
   // [t0, t1], each evaluated without cancellation (expm1 and a series for Δ ≪ τ), to a few ulps.
-  // With the constant τ; the second form for one segment's τ (tau_s >= 0).
+  // With the constant τ (or the second-order LC's weights); the second form for one segment's τ (tau_s >= 0).
   LightWeights weights(double t0, double t1) const;
   LightWeights weights(double t0, double t1, double tau_s) const;
   double integral(double t0, double t1, double previous_state, double level) const;
+  double integral(double t0, double t1, const LcMotion& previous_state, double level) const;
   // s(T): the state the frame leaves for the next one (the level itself when τ = 0).
   double end_state(double previous_state, double level) const;
+  // With the rate: the second-order LC's state after the frame (first-order models: their level, at rate 0).
+  LcMotion end_state(const LcMotion& previous_state, double level) const;
 
  private:
   PanelLightConfig config_;
@@ -116,10 +133,15 @@ class PanelLight {
   double window_end_ = 0.0;
   double decay_ = 0.0;  // e^{−T/τ}
   std::optional<LcResponse> response_;
+  std::optional<LcSecondOrder> second_order_;
+
+  // [t0, t1] (checked: within [0, T]) cut to the lit window.
+  std::pair<double, double> lit_part(double t0, double t1) const;
 };
 
 // The light of `panel` at `refresh_hz`: an OLED emits for panel.oled.duty of the frame from its start with no LC
-// response; an LCD holds (or strobes) with the level-dependent LC response options.lc_response. Throws
+// response; an LCD holds (or strobes) with the level-dependent LC response options.lc_response, or with the
+// second-order LC when its preset has one (panel.lcd.lc_second_order, which then replaces options.lc_response). Throws
 // std::invalid_argument naming the argument.
 PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOptions& options = {});
 

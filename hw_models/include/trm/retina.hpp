@@ -88,7 +88,8 @@ struct RetinaOptions {
 };
 
 // The retinal image (time average, 1×N) of one scan line shown for K frames: `frames` K×N, row n the steady levels
-// frame n drives (PanelLight's L). `previous` (1×N) is the LC state before frame 0; empty: settled at frame 0.
+// frame n drives (PanelLight's L). `previous` (1×N) is the LC state before frame 0 (at rest, for a second-order LC);
+// empty: settled at frame 0.
 // Throws std::invalid_argument naming the argument (empty or non-CV_64F `frames`, negative or non-finite levels,
 // `previous` of another size or type, eye_velocity_deg_s not finite, substeps < 1, row outside [0, rows)).
 cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s,
