@@ -142,7 +142,7 @@ std::unique_ptr<FrameSource> PipelineOptions::open_source() const {
 }
 
 void PipelineOptions::add_options(CLI::App& cmd) {
-  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter, square)")
+  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter, headturn, square)")
       ->capture_default_str();
   cmd.add_option("--input", input, "Image sequence glob ('DIR/frame_*.png', sorted by name, sRGB) or a video file");
   cmd.add_option("--image", image, "Image for the panorama and static scenes (default: procedural texture)");
@@ -222,7 +222,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
 
 void PipelineOptions::add_method_option(CLI::App& cmd) {
   cmd.add_option("--method", method,
-                 "Display method: trm, full, half-rate, interlace[:double], bfi or ncsfi (`trm methods` lists them)")
+                 "Display method: trm, full, half-rate, interlace[:double], bfi, ncsfi, kim[:OPTIONS], "
+                 "kim-trm[:OPTIONS] or reprojection (`trm methods` lists them)")
       ->capture_default_str();
 }
 
@@ -235,6 +236,7 @@ MethodSetup PipelineOptions::method_setup() const {
   setup.decoder = fixed_config_of(*this);
   setup.impl = method_impl();
   setup.option = find_display_method(method).option;
+  setup.refresh_hz = refresh_hz;
   return setup;
 }
 

@@ -38,7 +38,8 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
     frames = options.default_frames;
   }
 
-  const MethodSetup setup = options.method_setup();
+  MethodSetup setup = options.method_setup();
+  setup.scene = source.get();  // the renderer's knowledge of its scene (head poses, motion)
   const MethodChoice method = find_display_method(options.method);
   const std::unique_ptr<MethodSender> sender = method.method->make_sender(setup);
   const std::unique_ptr<MethodDisplay> display = method.method->make_display(setup);

@@ -10,6 +10,7 @@
 #include "trm/decoder.hpp"
 #include "trm/fixed_decoder.hpp"
 #include "trm/frame.hpp"
+#include "trm/scene.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -28,6 +29,11 @@ struct MethodSetup {
   FixedDecoderConfig decoder;
   std::string impl = "reference";
   std::string option;
+  // What the GPU side knows of the scene besides its frames (head poses, motion), for the methods that use it (kim,
+  // kim-trm, reprojection); null for a recorded input and wherever only the schedule is asked for. Outlives the
+  // sender.
+  const FrameSource* scene = nullptr;
+  double refresh_hz = 90.0;  // the frame rate, for the methods that measure speed per frame
 };
 
 // One view the GPU side sends, with what it cost to render.

@@ -191,10 +191,14 @@ DisplayMethod plain_frame_method(std::string name, std::string summary, Between 
   m.make_sender = [between](const MethodSetup& setup) -> std::unique_ptr<MethodSender> {
     return std::make_unique<FullViewSender>(setup.decoder.decoder.link, between == Between::Nothing);
   };
-  m.make_display = [between](const MethodSetup& setup) -> std::unique_ptr<MethodDisplay> {
-    return std::make_unique<PlainFrameDisplay>(setup.decoder.decoder, between);
+  m.make_display = [between](const MethodSetup& setup) {
+    return make_plain_frame_display(setup.decoder.decoder, between);
   };
   return m;
+}
+
+std::unique_ptr<MethodDisplay> make_plain_frame_display(const DecoderConfig& config, Between between) {
+  return std::make_unique<PlainFrameDisplay>(config, between);
 }
 
 cv::Mat linear_of_codes(const cv::Mat& codes, const FrameMeta& meta) {

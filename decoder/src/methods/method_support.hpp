@@ -88,6 +88,8 @@ enum class Between {
 // A method that renders and sends whole frames (every slot, or TRM's full slots only) and shows them through
 // PanelShow: full, half-rate, bfi differ only in `between`.
 DisplayMethod plain_frame_method(std::string name, std::string summary, Between between);
+// The headset side of plain_frame_method, for a method with a sender of its own.
+std::unique_ptr<MethodDisplay> make_plain_frame_display(const DecoderConfig& config, Between between);
 
 // Linear light of received link codes (the view's transfer function), CV_64FC3.
 cv::Mat linear_of_codes(const cv::Mat& codes, const FrameMeta& meta);
