@@ -214,7 +214,7 @@ void PipelineOptions::add_options(CLI::App& cmd) {
            impl = name;
            impl_given = true;
          },
-         "Decoder of the methods that send TRM frames (trm, ncsfi): reference (double), fixed (fixed-point, "
+         "Decoder of the methods that send TRM frames (trm, ncsfi, kim-trm): reference (double), fixed (fixed-point, "
          "line-buffered streaming: the hardware model) or fixed-frame (the same arithmetic frame at a time); each "
          "conceals lines and views lost on the link")
       ->default_str(impl);
