@@ -102,7 +102,8 @@ TEST(DisplayMethods, RegistryListsTheTableOneBaselinesAndRefusesUnknownNamesAndO
     EXPECT_NE(m.make_sender, nullptr) << m.name;
     EXPECT_NE(m.make_display, nullptr) << m.name;
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"trm", "full", "half-rate", "interlace", "bfi", "ncsfi", "didyk"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"trm", "full", "half-rate", "interlace", "bfi", "ncsfi", "didyk", "kim",
+                                             "kim-trm", "reprojection"}));
   EXPECT_EQ(find_display_method("interlace:double").option, "double");
   try {
     (void)find_display_method("quincunx");

@@ -27,7 +27,7 @@ bool in_unit_range(const cv::Mat& m) { return cv::checkRange(m, true, nullptr, 0
 double max_diff(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
 
 TEST(Scenes, AllNamesAreRegistered) {
-  const std::vector<std::string> expected{"discs", "text", "panorama", "line", "zoneplate", "checker", "flash", "static", "jitter", "square"};
+  const std::vector<std::string> expected{"discs", "text", "panorama", "line", "zoneplate", "checker", "flash", "static", "jitter", "headturn", "square"};
   EXPECT_EQ(scene_names(), expected);
 }
 
@@ -220,7 +220,7 @@ TEST(Jitter, MovesByTinyRandomAmountsAndReportsIt) {
 }
 
 TEST(Scenes, MotionScaleRunsEveryMotionThatManyTimesAsFast) {
-  for (const std::string name : {"discs", "line", "zoneplate", "text", "panorama"}) {
+  for (const std::string name : {"discs", "line", "zoneplate", "text", "panorama", "headturn"}) {
     SceneParams fast = small_params(40, 24);
     fast.motion_scale = 2.0;
     auto scaled = make_scene(name, fast);

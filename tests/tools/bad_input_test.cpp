@@ -263,6 +263,8 @@ TEST_F(BadInput, InputsThatAreNotInputs) {
       {"compare --speed 5 --scene jitter --size 8x8 --frames 2", "has no motion whose speed can be set"},
       {"run --method interlace:triple --size 8x8 --frames 2", "--method"},
       {"run --method bfi: --size 8x8 --frames 2", "--method"},
+      {"run --method kim:d=2 --size 8x8 --frames 2", "d must be in [0, 1]"},
+      {"compare --methods kim:wmin=0.05 --size 8x8 --frames 2", "wlb <= wmin"},
       {"run --method full --impl fixed --size 8x8 --frames 2", "--method"},
       {"run --method interlace --size 8x1 --frames 2", "2 rows"},
       {"decode --out o", "--input"},

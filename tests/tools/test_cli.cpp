@@ -380,7 +380,8 @@ TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFram
   ASSERT_EQ(list.exit_code, 0) << list.output;
   const std::vector<std::pair<std::string, double>> methods = {
       {"trm", 0.625}, {"full", 1.0}, {"half-rate", 0.5}, {"interlace", 0.5}, {"interlace:double", 0.5}, {"bfi", 0.5},
-      {"ncsfi", 0.625}, {"didyk", 1.0}, {"didyk:2-hold", 0.5}};
+      {"ncsfi", 0.625}, {"didyk", 1.0}, {"didyk:2-hold", 0.5}, {"kim", 1.0}, {"kim-trm", 0.625},
+      {"reprojection", 1.0}};
   for (const auto& [method, sent_ratio] : methods) {
     EXPECT_NE(list.output.find(method.substr(0, method.find(':'))), std::string::npos) << method;
     const std::string out = tmp.str("run-" + method.substr(0, method.find(':')) + std::to_string(method.size()));
@@ -404,7 +405,7 @@ TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFram
     }
     EXPECT_EQ(rows, 6) << method;
     // The plain-frame methods are decoded by the reference; TRM's family by the hardware model.
-    const bool fixed = method == "trm" || method == "ncsfi";
+    const bool fixed = method == "trm" || method == "ncsfi" || method == "kim-trm";
     EXPECT_EQ(report["parameters"]["impl"], fixed ? "fixed" : "reference") << method;
   }
 }
@@ -471,7 +472,7 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   const nlohmann::json report = nlohmann::json::parse(in);
   std::map<std::string, nlohmann::json> by_method;
   for (const auto& m : report["methods"]) by_method[m["method"].get<std::string>()] = m;
-  ASSERT_EQ(by_method.size(), 7u);
+  ASSERT_EQ(by_method.size(), 10u);
   // Pixels: exact fractions of full rate (216x120 at r = 1/2 reduces to 108x60).
   EXPECT_DOUBLE_EQ(by_method["trm"]["pixels_rendered_saved_percent"].get<double>(), 37.5);
   EXPECT_DOUBLE_EQ(by_method["ncsfi"]["pixels_rendered_saved_percent"].get<double>(), 50.0);
@@ -483,6 +484,16 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   // Didyk renders frames 0, 3 and 6 of the 8 and morphs the others GPU-side: every frame crosses the link whole.
   EXPECT_DOUBLE_EQ(by_method["didyk"]["pixels_rendered_saved_percent"].get<double>(), 62.5);
   EXPECT_DOUBLE_EQ(by_method["didyk"]["pixels_sent_saved_percent"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(by_method["kim"]["pixels_rendered_saved_percent"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(by_method["kim-trm"]["pixels_sent_saved_percent"].get<double>(), 37.5);
+  EXPECT_DOUBLE_EQ(by_method["reprojection"]["pixels_rendered_saved_percent"].get<double>(), 50.0);
+  EXPECT_DOUBLE_EQ(by_method["reprojection"]["pixels_sent_saved_percent"].get<double>(), 0.0);
+  // The pan moves the world, not the head: Kim's dynamic map leaves it alone and there is no head rotation to
+  // reproject, so kim shows what full rate shows and reprojection what half rate shows.
+  EXPECT_EQ(by_method["kim"]["energy_vs_full_rate"].get<double>(), 0.0);
+  EXPECT_EQ(by_method["kim"]["mtcd"].get<double>(), by_method["full"]["mtcd"].get<double>());
+  EXPECT_EQ(by_method["reprojection"]["energy_vs_continuous"].get<double>(),
+            by_method["half-rate"]["energy_vs_continuous"].get<double>());
   // Light: black frames and black rows halve it; a repeat does not flicker; full rate is its own reference.
   EXPECT_NEAR(by_method["bfi"]["luminance_percent"].get<double>(), 50.0, 0.5);
   EXPECT_NEAR(by_method["interlace"]["luminance_percent"].get<double>(), 50.0, 0.5);

@@ -142,7 +142,7 @@ std::unique_ptr<FrameSource> PipelineOptions::open_source() const {
 }
 
 void PipelineOptions::add_options(CLI::App& cmd) {
-  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter, square)")
+  cmd.add_option("--scene", scene, "Built-in scene (discs, text, panorama, line, zoneplate, checker, flash, static, jitter, headturn, square)")
       ->capture_default_str();
   cmd.add_option("--input", input, "Image sequence glob ('DIR/frame_*.png', sorted by name, sRGB) or a video file");
   cmd.add_option("--image", image, "Image for the panorama and static scenes (default: procedural texture)");
@@ -214,7 +214,7 @@ void PipelineOptions::add_options(CLI::App& cmd) {
            impl = name;
            impl_given = true;
          },
-         "Decoder of the methods that send TRM frames (trm, ncsfi): reference (double), fixed (fixed-point, "
+         "Decoder of the methods that send TRM frames (trm, ncsfi, kim-trm): reference (double), fixed (fixed-point, "
          "line-buffered streaming: the hardware model) or fixed-frame (the same arithmetic frame at a time); each "
          "conceals lines and views lost on the link")
       ->default_str(impl);
@@ -222,8 +222,8 @@ void PipelineOptions::add_options(CLI::App& cmd) {
 
 void PipelineOptions::add_method_option(CLI::App& cmd) {
   cmd.add_option("--method", method,
-                 "Display method: trm, full, half-rate, interlace[:double], bfi, ncsfi or didyk[:N|:hold|:N-hold] "
-                 "(`trm methods` lists them)")
+                 "Display method: trm, full, half-rate, interlace[:double], bfi, ncsfi, didyk[:N|:hold|:N-hold], "
+                 "kim[:OPTIONS], kim-trm[:OPTIONS] or reprojection (`trm methods` lists them)")
       ->capture_default_str();
 }
 

@@ -40,6 +40,7 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
 
   MethodSetup setup = options.method_setup();
   setup.scene.at = [scene = source.get()](std::int64_t t) { return scene->motion(t); };
+  setup.source = source.get();  // the renderer's knowledge of its scene (head poses, motion)
   const MethodChoice method = find_display_method(options.method);
   const std::unique_ptr<MethodSender> sender = method.method->make_sender(setup);
   const std::unique_ptr<MethodDisplay> display = method.method->make_display(setup);

@@ -37,6 +37,9 @@ struct MethodSetup {
     double refresh_hz = 90.0;  // to turn velocities into displacements per frame
     double pixels_per_degree = viewer_preset("vive").pixels_per_degree;  // the viewer's, for the pursuit limit
   } scene;
+  // The source the GPU side renders (head poses, motion), for the methods that use it (kim, kim-trm,
+  // reprojection); null for a recorded input and wherever only the schedule is asked for. Outlives the sender.
+  const FrameSource* source = nullptr;
 };
 
 // One view the GPU side sends, with what it cost to render.

@@ -2,6 +2,8 @@
 // and real inputs (image sequences, video files).
 #pragma once
 
+#include "trm/head_pose.hpp"
+
 #include <opencv2/core.hpp>
 
 #include <memory>
@@ -48,9 +50,13 @@ class FrameSource {
   // and std::invalid_argument on NaN/Inf/negative/out-of-range content.
   virtual cv::Mat linear_frame(std::int64_t t) = 0;
   virtual Motion motion(std::int64_t t) const = 0;
+  // The head pose the view of frame t is rendered for, for the scenes whose motion is the head rotating (jitter,
+  // headturn): there the world is still and the head's rotation is all that moves it on the panel (which motion()
+  // reports as well). nullopt for the others: what moves in them moves in the world.
+  virtual std::optional<HeadView> head_view(std::int64_t) const { return std::nullopt; }
 };
 
-// Names: discs, text, panorama, line, zoneplate, checker, flash, static, jitter, square.
+// Names: discs, text, panorama, line, zoneplate, checker, flash, static, jitter, headturn, square.
 std::vector<std::string> scene_names();
 // Throws std::invalid_argument naming the valid scenes when name is unknown.
 std::unique_ptr<FrameSource> make_scene(const std::string& name, const SceneParams& params);

@@ -31,6 +31,7 @@ class ScaledMotion final : public FrameSource {
   int height() const override { return scene_->height(); }
   std::optional<std::int64_t> frame_count() const override { return scene_->frame_count(); }
   cv::Mat linear_frame(std::int64_t t) override { return scene_->linear_frame(t); }
+  std::optional<HeadView> head_view(std::int64_t t) const override { return scene_->head_view(t); }
   Motion motion(std::int64_t t) const override {
     Motion m = scene_->motion(t);
     m.global_velocity_px_s *= scale_;
@@ -54,7 +55,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"discs", scenes::make_discs},         {"text", scenes::make_text},       {"panorama", scenes::make_panorama},
       {"line", scenes::make_line},           {"zoneplate", scenes::make_zoneplate}, {"checker", scenes::make_checker},
       {"flash", scenes::make_flash},         {"static", scenes::make_static},   {"jitter", scenes::make_jitter},
-      {"square", scenes::make_square},
+      {"headturn", scenes::make_headturn}, {"square", scenes::make_square},
   };
   return table;
 }

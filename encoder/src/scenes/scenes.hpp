@@ -35,6 +35,7 @@ std::unique_ptr<FrameSource> make_text(const SceneParams& params);
 std::unique_ptr<FrameSource> make_panorama(const SceneParams& params);
 std::unique_ptr<FrameSource> make_static(const SceneParams& params);
 std::unique_ptr<FrameSource> make_jitter(const SceneParams& params);
+std::unique_ptr<FrameSource> make_headturn(const SceneParams& params);
 std::unique_ptr<FrameSource> make_square(const SceneParams& params);
 
 }  // namespace trm::scenes

@@ -1,4 +1,4 @@
-// Scenes built on an image or texture: scrolling text, panorama, static image, head jitter.
+// Scenes built on an image or texture: scrolling text, panorama, static image, head jitter and head turn.
 // Content is a piecewise-constant texture (one constant per texel, itself box-filtered when it was made),
 // moved by sub-pixel amounts; each output pixel is the exact box-filter average over its square.
 #include "scenes/scene_support.hpp"
@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace trm::scenes {
@@ -167,17 +168,20 @@ class StaticScene final : public AnalyticScene {
   cv::Mat image_;
 };
 
-// --- jitter (Kim et al., head-jittered aliasing): the still image under tiny involuntary head rotations -
-// Small yaw/pitch rotations move the image on the panel by (nearly) a uniform translation, which is what
-// is modelled: an Ornstein-Uhlenbeck process per axis, stationary standard deviation kSigmaDeg degrees,
-// correlation time kTauS, sampled at the refresh rate and seeded. kFovDeg converts degrees to pixels.
-class JitterScene final : public AnalyticScene {
+// --- jitter and headturn: a still world seen by a rotating head ----------------------------------------
+// The world is a texture on a plane in front of the viewer: at the rest pose the view is the texture's centre
+// crop (so jitter at rest is the static scene), and a head at orientation R sees at pixel p the texture where the
+// ray R K^-1 p meets the plane (trm/head_pose.hpp's pinhole view, kFovDeg across). Each pixel is the box filter of
+// the piecewise-constant texture over its square moved to where the rotation puts its centre: a bilinear blend of
+// four texels. (Exact for a translation; the rotation also scales the square, by less than 0.1 % for the jitter's
+// rotations and up to 47 % at the view's edge at the head turn's largest yaw.) The texture is wide enough that no
+// pose of the scene sees past it.
+class HeadRotationScene : public AnalyticScene {
  public:
-  explicit JitterScene(const SceneParams& p) : AnalyticScene("jitter", p), noise_(scene_support::mix64(p.seed ^ 0x6a6974746572ULL)) {
-    px_per_deg_ = p.width / kFovDeg;
-    const double sigma_px = kSigmaDeg * px_per_deg_;
-    margin_ = static_cast<int>(std::ceil(6.0 * sigma_px)) + 2;
-    const int tw = p.width + 2 * margin_, th = p.height + 2 * margin_;
+  HeadRotationScene(const std::string& name, const SceneParams& p, cv::Vec2d largest_angles_deg)
+      : AnalyticScene(name, p), view_(PinholeView::of_fov(p.width, p.height, kFovDeg)) {
+    margin_ = texture_margin(largest_angles_deg);
+    const int tw = p.width + 2 * margin_.width, th = p.height + 2 * margin_.height;
     if (!p.image_path.empty()) {
       cv::Mat fitted = scene_support::fit_cover(scene_support::load_linear_image(p.image_path), tw, th);
       fitted.convertTo(texture_, CV_32FC3);
@@ -187,49 +191,143 @@ class JitterScene final : public AnalyticScene {
   }
 
   cv::Mat linear_frame(std::int64_t t) override {
-    const cv::Vec2d o = offset(t);
-    return box_shift(texture_, margin_ + o[0], margin_ + o[1], width(), height(), /*wrap_x=*/false);
+    const Eigen::Matrix3d rotation = orientation(t).toRotationMatrix();
+    const cv::Point2d c = view_.centre();
+    const double f = view_.focal_px;
+    cv::Mat frame(height(), width(), CV_64FC3);
+    for (int y = 0; y < height(); ++y) {
+      auto* row = frame.ptr<cv::Vec3d>(y);
+      for (int x = 0; x < width(); ++x) {
+        const Eigen::Vector3d d = rotation * view_.ray({static_cast<double>(x), static_cast<double>(y)});
+        row[x] = bilinear_at(texture_, c.x + f * d.x() / d.z() + margin_.width, c.y + f * d.y() / d.z() + margin_.height);
+      }
+    }
+    return frame;
   }
 
+  std::optional<HeadView> head_view(std::int64_t t) const override { return HeadView{orientation(t), view_}; }
+
+ protected:
+  static constexpr double kFovDeg = 100.0;  // horizontal field of view of the view
+
+  // Yaw (positive: the head turns right, content moves left) and pitch (positive: the head turns down), degrees.
+  virtual cv::Vec2d angles_deg(std::int64_t t) const = 0;
+
+  Eigen::Quaterniond orientation(std::int64_t t) const {
+    const cv::Vec2d a = angles_deg(t) * (std::numbers::pi / 180.0);
+    return Eigen::Quaterniond(Eigen::AngleAxisd(a[0], Eigen::Vector3d::UnitY()) *
+                              Eigen::AngleAxisd(-a[1], Eigen::Vector3d::UnitX()));
+  }
+  // Where the view's centre pixel lands on the texture's rest view (pixels) at frame t.
+  cv::Point2d centre_on_texture(std::int64_t t) const {
+    return reproject_pixel(view_.centre(), orientation(t), Eigen::Quaterniond::Identity(), view_);
+  }
+  const PinholeView& view() const { return view_; }
+
+ private:
+  // How far past the view's edges any pose within the largest angles looks, plus a texel for the bilinear blend.
+  cv::Size texture_margin(cv::Vec2d largest_deg) const {
+    double reach_x = 0.0, reach_y = 0.0;
+    const double w = width() - 1.0, h = height() - 1.0;
+    for (const double yaw : {-largest_deg[0], largest_deg[0]}) {
+      for (const double pitch : {-largest_deg[1], largest_deg[1]}) {
+        const double r = std::numbers::pi / 180.0;
+        const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw * r, Eigen::Vector3d::UnitY()) *
+                                   Eigen::AngleAxisd(-pitch * r, Eigen::Vector3d::UnitX()));
+        for (const cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(w, 0), cv::Point2d(0, h), cv::Point2d(w, h),
+                                    cv::Point2d(0.5 * w, 0), cv::Point2d(0.5 * w, h), cv::Point2d(0, 0.5 * h),
+                                    cv::Point2d(w, 0.5 * h)}) {
+          const cv::Point2d moved = reproject_pixel(p, q, Eigen::Quaterniond::Identity(), view_);
+          reach_x = std::max(reach_x, std::abs(moved.x - p.x));
+          reach_y = std::max(reach_y, std::abs(moved.y - p.y));
+        }
+      }
+    }
+    return {static_cast<int>(std::ceil(reach_x)) + 2, static_cast<int>(std::ceil(reach_y)) + 2};
+  }
+
+  PinholeView view_;
+  cv::Size margin_;
+  cv::Mat texture_;
+};
+
+// jitter (Kim et al., head-jittered aliasing): the still image under tiny involuntary head rotations, an
+// Ornstein-Uhlenbeck process per axis, stationary standard deviation kSigmaDeg degrees, correlation time kTauS,
+// sampled at the refresh rate and seeded.
+class JitterScene final : public HeadRotationScene {
+ public:
+  explicit JitterScene(const SceneParams& p)
+      : HeadRotationScene("jitter", p, cv::Vec2d::all(kLimitDeg)),
+        noise_(scene_support::mix64(p.seed ^ 0x6a6974746572ULL)) {}
+
   Motion motion(std::int64_t t) const override {
-    // The view samples the texture at +offset, so content moves by -offset; central difference in time.
+    // Content moves opposite to where the view's centre lands on the texture; central difference in time.
     const std::int64_t a = t > 0 ? t - 1 : t;
     const std::int64_t b = t + 1;
-    const cv::Vec2d d = offset(b) - offset(a);
+    const cv::Point2d d = centre_on_texture(b) - centre_on_texture(a);
     Motion m;
-    m.global_velocity_px_s = -d * (params().refresh_hz / static_cast<double>(b - a));
+    m.global_velocity_px_s = -cv::Vec2d(d.x, d.y) * (params().refresh_hz / static_cast<double>(b - a));
     return m;
   }
 
  private:
-  static constexpr double kFovDeg = 100.0;    // horizontal field of view of the view
-  static constexpr double kSigmaDeg = 0.05;   // involuntary head rotation while holding still
+  static constexpr double kSigmaDeg = 0.05;  // involuntary head rotation while holding still
   static constexpr double kTauS = 0.25;
+  static constexpr double kLimitDeg = 6.0 * kSigmaDeg;  // the walk is clamped here (never reached in practice)
 
-  cv::Vec2d offset(std::int64_t t) const {
+  cv::Vec2d angles_deg(std::int64_t t) const override {
     seconds(t);
-    while (static_cast<std::int64_t>(offsets_.size()) <= t) {
-      const double sigma_px = kSigmaDeg * px_per_deg_;
-      if (offsets_.empty()) {
-        offsets_.push_back({sigma_px * noise_.next(), sigma_px * noise_.next()});  // start in the stationary state
+    while (static_cast<std::int64_t>(angles_.size()) <= t) {
+      if (angles_.empty()) {
+        angles_.push_back({kSigmaDeg * noise_.next(), kSigmaDeg * noise_.next()});  // start in the stationary state
         continue;
       }
       const double decay = std::exp(-1.0 / (params().refresh_hz * kTauS));
-      const double kick = sigma_px * std::sqrt(1.0 - decay * decay);
-      const cv::Vec2d prev = offsets_.back();
-      offsets_.push_back({prev[0] * decay + kick * noise_.next(), prev[1] * decay + kick * noise_.next()});
+      const double kick = kSigmaDeg * std::sqrt(1.0 - decay * decay);
+      const cv::Vec2d prev = angles_.back();
+      angles_.push_back({prev[0] * decay + kick * noise_.next(), prev[1] * decay + kick * noise_.next()});
     }
-    const cv::Vec2d o = offsets_[static_cast<std::size_t>(t)];
-    const double limit = margin_ - 1.0;  // never sample outside the texture
-    return {std::clamp(o[0], -limit, limit), std::clamp(o[1], -limit, limit)};
+    const cv::Vec2d a = angles_[static_cast<std::size_t>(t)];
+    return {std::clamp(a[0], -kLimitDeg, kLimitDeg), std::clamp(a[1], -kLimitDeg, kLimitDeg)};
   }
 
-  double px_per_deg_ = 1.0;
-  int margin_ = 2;
-  cv::Mat texture_;
   // The process is generated in order and memoised, so any access order gives the same frames.
   mutable scene_support::NormalStream noise_;
-  mutable std::vector<cv::Vec2d> offsets_;
+  mutable std::vector<cv::Vec2d> angles_;
+};
+
+// headturn: the same world under a deliberate head turn, yaw sweeping back and forth at kTurnDegS between
+// -kTurnAmplitudeDeg and +kTurnAmplitudeDeg (starting at 0, turning right), no pitch.
+class HeadTurnScene final : public HeadRotationScene {
+ public:
+  explicit HeadTurnScene(const SceneParams& p)
+      : HeadRotationScene("headturn", p, cv::Vec2d(kTurnAmplitudeDeg, 0.0)) {}
+
+  Motion motion(std::int64_t t) const override {
+    // Per second of scene time: d/ds of f tan(yaw) at the centre, opposite in sign (content moves left).
+    const double yaw = angles_deg(t)[0] * std::numbers::pi / 180.0;
+    const double cos_yaw = std::cos(yaw);
+    Motion m;
+    m.global_velocity_px_s = {-yaw_rate_deg_s(t) * std::numbers::pi / 180.0 * view().focal_px / (cos_yaw * cos_yaw),
+                              0.0};
+    return m;
+  }
+
+ private:
+  static constexpr double kTurnDegS = 10.0;  // a slow deliberate turn: within Kim et al.'s h_max, so it blends
+  static constexpr double kTurnAmplitudeDeg = 8.0;
+
+  // The sweep as a triangle wave of period 4 in units of the amplitude: phase in [0, 1) rises, [1, 3) falls back.
+  double phase(std::int64_t t) const { return std::fmod(kTurnDegS * seconds(t) / kTurnAmplitudeDeg, 4.0); }
+  double yaw_rate_deg_s(std::int64_t t) const {
+    const double u = phase(t);
+    return (u < 1.0 || u >= 3.0) ? kTurnDegS : -kTurnDegS;
+  }
+  cv::Vec2d angles_deg(std::int64_t t) const override {
+    const double u = phase(t);
+    const double tri = u < 1.0 ? u : (u < 3.0 ? 2.0 - u : u - 4.0);
+    return {kTurnAmplitudeDeg * tri, 0.0};
+  }
 };
 
 }  // namespace
@@ -238,5 +336,6 @@ std::unique_ptr<FrameSource> make_text(const SceneParams& p) { return std::make_
 std::unique_ptr<FrameSource> make_panorama(const SceneParams& p) { return std::make_unique<PanoramaScene>(p); }
 std::unique_ptr<FrameSource> make_static(const SceneParams& p) { return std::make_unique<StaticScene>(p); }
 std::unique_ptr<FrameSource> make_jitter(const SceneParams& p) { return std::make_unique<JitterScene>(p); }
+std::unique_ptr<FrameSource> make_headturn(const SceneParams& p) { return std::make_unique<HeadTurnScene>(p); }
 
 }  // namespace trm::scenes
