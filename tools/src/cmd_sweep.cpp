@@ -1,5 +1,6 @@
 // `trm sweep`: error against run time and memory for every approximation knob of the fixed-point decoder
-// (DESIGN §7). Writes sweep.csv, sweep.md, sweep_<knob>.png and report.json into one output directory.
+// (DESIGN §7). Writes sweep.csv, sweep.md, sweep_<knob>.png, sweep_pareto.png and report.json into one output
+// directory.
 #include "commands.hpp"
 #include "output_dir.hpp"
 #include "run_report.hpp"
@@ -36,13 +37,14 @@ std::string command_line(const CLI::App& cmd) {
 
 std::string knob_listing() {
   std::ostringstream s;
-  const FixedDecoderConfig base;
+  const SweepConfig base;
   for (const auto& k : sweep_knobs()) {
     s << "  " << std::left << std::setw(30) << k.name << std::right << " default " << std::setw(5) << k.get(base)
       << "  values";
     for (int v : k.values) s << " " << v;
     s << "\n      " << k.description << "; cost: " << k.cost
-      << (k.oled && k.lcd ? "" : k.oled ? " (OLED panels only)" : " (LCD panel only)") << "\n";
+      << (k.oled && k.lcd ? "" : k.oled ? " (OLED panels only)" : " (LCD panel only)")
+      << (k.linear_space_only ? " (swept around a --resample-space linear base)" : "") << "\n";
   }
   return s.str();
 }
@@ -58,9 +60,9 @@ void register_sweep(CLI::App& app, Action& action) {
   auto quick = std::make_shared<bool>(false);
   auto list = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
-      "sweep", "Sweep every approximation knob of the fixed-point decoder alone and report error against the "
-               "reference vs decode time and memory (default: discs, 270x300, 12 frames, r = 1/2, vive OLED; a few "
-               "minutes on two cores)");
+      "sweep", "Sweep every approximation knob (the fixed-point decoder's, the eye model's) alone and report "
+               "error against the reference vs run time and memory, with the Pareto fronts (default: discs, 270x300, "
+               "12 frames, r = 1/2, vive OLED; a few minutes on two cores)");
   options->pipeline.add_options(*cmd);
   // The sweep always decodes with the streaming fixed-point decoder beside the reference.
   cmd->remove_option(cmd->get_option("--impl"));
@@ -112,6 +114,8 @@ void register_sweep(CLI::App& app, Action& action) {
         write_sweep_plot(dir.file(name), result, knob);
         ++plots;
       }
+      write_pareto_plot(dir.file("sweep_pareto.png"), result);
+      ++plots;
       dir.write_text("report.json", sweep_json(result).dump(2) + "\n");
       dir.commit();
       std::cout << "trm sweep: " << result.knobs.size() << " knob(s)\n"

@@ -1,11 +1,16 @@
-// `trm sweep` (DESIGN §7, error against run time): every approximation knob of the fixed-point decoder swept alone
-// around the base configuration (the default formats plus the shared options), each point decoding the same encoded
-// sequence with the streaming decoder and held to the double-precision reference: output-code and linear-light error,
-// decode time per frame, and the on-chip / off-chip memory of FixedStreamingDecoder::report(). The points are
-// written out by sweep_report.hpp.
+// `trm sweep` (DESIGN §7, error against run time): every approximation knob swept alone around the base
+// configuration (the default formats plus the shared options). A decoder knob's point decodes the same encoded
+// sequence with the streaming decoder and is held to the double-precision reference: output-code and linear-light
+// error, the perceived sequence (sweep_perceived.hpp) against the reference's seen by the same eye, decode time per
+// frame, and the on-chip / off-chip memory of FixedStreamingDecoder::report(). An eye-model knob's point watches the
+// base decoder's output with the knob's value against the reference decoder's seen by the exact eye
+// (kExactEyeSubsteps): perceived error and eye-model time per frame. The linear-resample-space knobs sweep around a
+// base of their own in that space when the run's space is the encoded one. The points are written out by
+// sweep_report.hpp.
 #pragma once
 
 #include "pipeline.hpp"
+#include "sweep_perceived.hpp"
 
 #include "trm/fixed_decoder.hpp"
 #include "trm/metrics.hpp"
@@ -16,6 +21,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,7 +29,13 @@ namespace trm::cli {
 
 using Json = nlohmann::ordered_json;
 
-// One approximation knob: an integer field (or derived width) of FixedDecoderConfig.
+// Everything a knob can set: the fixed-point decoder and the eye model that watches its output.
+struct SweepConfig {
+  FixedDecoderConfig decoder;
+  int eye_substeps = kDefaultRetinaSubsteps;  // RetinaOptions::substeps of the perceived sequence
+};
+
+// One approximation knob: an integer field (or derived width) of SweepConfig.
 struct SweepKnob {
   std::string name;         // as --knob takes it, e.g. "residual_bits"
   std::string description;  // what it sets
@@ -31,10 +43,11 @@ struct SweepKnob {
   std::vector<int> values;  // the default sweep range (the base value is always added)
   bool oled = true;         // used with an OLED panel
   bool lcd = true;          // used with the LCD panel
-  bool linear_space_only = false;  // used when D and U act in linear light (--resample-space linear) only
-  std::function<int(const FixedDecoderConfig&)> get;
+  bool linear_space_only = false;  // used when D and U act in linear light: swept around a linear-space base
+  bool eye_model = false;          // sets the eye model, not the decoder: the base decoder's output is watched
+  std::function<int(const SweepConfig&)> get;
   // Sets the knob on a copy of the base configuration; may throw std::invalid_argument (the point is rejected).
-  std::function<void(FixedDecoderConfig&, int)> set;
+  std::function<void(SweepConfig&, int)> set;
 };
 
 // Every knob, in pipeline order.
@@ -72,6 +85,11 @@ struct SweepPoint {
   double linear_rms = 0.0;
   // Drive value v before output quantisation (DecodedFrame::drive), in output LSB.
   double drive_max_lsb = 0.0;
+  // The perceived sequence against the reference's (decoder knobs: the same eye; eye-model knobs: the exact eye).
+  double perceived_psnr_db = 0.0;         // +inf: identical
+  double visual_difference = 0.0;
+  // Eye-model wall seconds per frame watched (eye-model knobs: the fastest of the repeats; decoder knobs: one run).
+  double eye_seconds_per_frame = 0.0;
   std::uint64_t residual_saturated = 0;  // rho samples saturated / rounded by the residual store, all frames
   std::uint64_t residual_rounded = 0;
   // Run time: decode wall seconds per view (each view's median over the repeats, averaged over the views), each
@@ -96,6 +114,7 @@ struct SweepPoint {
 struct SweepKnobResult {
   const SweepKnob* knob = nullptr;
   int default_value = 0;
+  ResampleSpace resample_space = ResampleSpace::Encoded;  // the space of the sequence and base it is swept around
   std::string skipped;                // non-empty: the knob does not apply (the reason)
   std::vector<SweepPoint> points;     // ascending value
   // The smallest value at and above which every accepted point meets the criterion (nullptr: the most precise
@@ -110,7 +129,15 @@ struct SweepResult {
   std::int64_t views = 0;             // decoded views per point
   double reference_seconds_per_frame = 0.0;
   SweepPoint base;                    // every knob at its base value
+  // The linear-resample-space knobs' own base (the run's space encoded, one of them chosen): the same options with
+  // --resample-space linear.
+  std::optional<SweepPoint> linear_base;
   std::vector<SweepKnobResult> knobs;
+  // The eye of the perceived sequences.
+  double pixels_per_degree = 0.0;
+  double target_velocity_deg_s = 0.0;
+  double eye_velocity_deg_s = 0.0;
+  int scan_line = 0;
   double wall_seconds = 0.0;
 };
 
