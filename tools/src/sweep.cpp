@@ -344,9 +344,17 @@ void SweepOptions::validate() const {
   // The recording keeps every view's codes, drive codes, drive and emitted light beside a pipeline run (twice when
   // the linear-resample-space knobs sweep around their own base).
   const std::int64_t frames = pipeline.frames > 0 ? pipeline.frames : pipeline.default_frames;
-  const std::int64_t views = frames * (pipeline.encoder.stereo ? 2 : 1) * 2;
-  require_memory("for the pipeline and " + std::to_string(views) + " recorded views",
-                 run_bytes_per_pixel(pipeline) + kRecordedViewBytesPerPixel * static_cast<double>(views),
+  const std::int64_t views = frames * (pipeline.encoder.stereo ? 2 : 1);
+  bool two_sequences = false;
+  for (const auto& knob : sweep_knobs()) {
+    const bool asked = knobs.empty() || std::find(knobs.begin(), knobs.end(), knob.name) != knobs.end();
+    two_sequences = two_sequences ||
+                    (asked && knob.linear_space_only && pipeline.encoder.resample_space != ResampleSpace::Linear);
+  }
+  require_memory("for the pipeline and " + std::to_string(views) + " recorded views" +
+                     (two_sequences ? " in each of two resample spaces" : ""),
+                 run_bytes_per_pixel(pipeline) +
+                     kRecordedViewBytesPerPixel * static_cast<double>(views) * (two_sequences ? 2.0 : 1.0),
                  cv::Size(pipeline.width, pipeline.height));
 }
 

@@ -594,7 +594,8 @@ std::string sweep_summary(const SweepResult& r) {
     << percent_text(r.base) << " identical, max " << general(r.base.max_lsb) << " LSB, "
     << ms(r.base.seconds_per_frame) << " ms/view, " << kib(r.base.on_chip_bits) << " KiB on / "
     << kib(r.base.off_chip_bits) << " KiB off chip at " << r.options.hw_size.width << "x" << r.options.hw_size.height
-    << "; perceived PSNR " << db_text(r.base.perceived_psnr_db) << " dB, visual difference "
+    << "; perceived PSNR " << db_text(r.base.perceived_psnr_db)
+    << (std::isinf(r.base.perceived_psnr_db) ? "" : " dB") << ", visual difference "
     << scientific(r.base.visual_difference)
     << "\n  cheapest value with >= " << kReferenceAgreementCriterion.min_identical_percent()
     << " % identical and max <= " << kReferenceAgreementCriterion.max_lsb << " LSB:\n";
