@@ -363,7 +363,7 @@ TEST(Sweep, ParetoFrontIsEveryUndominatedPoint) {
 TEST(Sweep, EyeSubstepsConvergeToTheExactEye) {
   // Wide enough that the fastest disc travels pixels per frame (speeds are fractions of the view size): at 48x40 the
   // eye's travel within a lit OLED window stays inside one pixel interval, where every sub-step count is exact.
-  auto o = small_sweep("eye_substeps", 240, 24, 4);
+  auto o = small_sweep("eye_substeps", 240, 32, 4);
   o.values = {1, 3, 4, 32, trm::cli::kExactEyeSubsteps};
   const auto result = trm::cli::run_sweep(o);
   ASSERT_EQ(result.knobs.size(), 1u);
