@@ -263,7 +263,7 @@ std::string summary_table_md(const SweepResult& r) {
 std::string sweep_markdown(const SweepResult& r) {
   std::ostringstream s;
   const auto& o = r.options;
-  s << "# Fixed-point decoder: error against run time and memory\n\n";
+  s << "# Every knob: error against run time and memory\n\n";
   s << "Regenerate with `" << o.command << "`.\n\n";
   s << "* sequence: " << header_line(r) << "; every knob swept alone, the others at the base configuration "
        "(the default formats, residual " << r.base.residual_format << ")\n";
@@ -566,6 +566,10 @@ void write_pareto_plot(const std::filesystem::path& path, const SweepResult& r) 
       continue;
     }
     chart.x = spread_axis(f.cost, f.cost_label);
+    // Room on the right for the front's labels.
+    const auto [lo, hi] = std::minmax_element(f.cost.begin(), f.cost.end());
+    const double span = *hi - *lo > 0 ? *hi - *lo : std::max(std::abs(*hi), 1.0);
+    chart.x.max = chart.x.scale == plot::Scale::Log ? *hi * 3.0 : *hi + 0.25 * span;
     std::vector<double> front_x, front_y;
     std::vector<std::string> labels;
     for (std::size_t i : f.front) {
