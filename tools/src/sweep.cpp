@@ -120,9 +120,8 @@ std::vector<SweepKnob> make_knobs() {
   // takes the eye at the step's middle), so on an LCD this knob is also the sub-frame sampling of the LC light.
   SweepKnob eye;
   eye.name = "eye_substeps";
-  eye.description = "eye model sub-frame steps S (retina.hpp): the eye's motion within a frame and, on an LCD, the "
-                    "sampling of the LC response's light (the response itself is exact per frame, no ODE step); "
-                    "values divide " + std::to_string(kExactEyeSubsteps);
+  eye.description = "eye model sub-frame steps S: the eye's motion and (LCD) the LC light's sampling within a frame; "
+                    "S divides " + std::to_string(kExactEyeSubsteps);
   eye.cost = "eye-model run time (no hardware)";
   eye.values = {1, 2, 4, 8, 16, 32, 64, 128};
   eye.eye_model = true;
