@@ -1,8 +1,10 @@
 // `trm sweep`: the outputs, the base point against a direct comparison of the two decoders, error falling as a
-// precision knob grows, rejected values reported, and bad knob names failing without output.
+// precision knob grows, rejected values reported, bad knob names failing without output, the linear-resample-space
+// knobs around their own base, the eye model's sub-steps converging, the perceived error and the Pareto front.
 #include "csv_reader.hpp"
 #include "pipeline.hpp"
 #include "sweep.hpp"
+#include "sweep_report.hpp"
 #include "trm_process.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -47,12 +50,13 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
   const fs::path out = tmp.path() / "out";
   for (const char* name : {"sweep.csv", "sweep.md", "report.json"}) EXPECT_TRUE(fs::exists(out / name)) << name;
 
-  // Every knob the OLED panel uses: its default range (the base value among it), one plot each.
+  // Every knob the OLED panel uses, the linear-resample-space and eye-model ones too: its default range (the base
+  // value among it), one plot each.
   std::size_t expected_rows = 0;
   std::map<std::string, std::size_t> values_of;
   for (const auto& knob : trm::cli::sweep_knobs()) {
     const fs::path plot = out / ("sweep_" + knob.name + ".png");
-    if (!knob.oled || knob.linear_space_only) {  // this sweep is OLED in the encoded resample space
+    if (!knob.oled) {  // this sweep is OLED
       EXPECT_FALSE(fs::exists(plot)) << knob.name;
       continue;
     }
@@ -63,28 +67,42 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
     values_of[knob.name] = knob.values.size();
     expected_rows += knob.values.size();
   }
+  const cv::Mat pareto = cv::imread((out / "sweep_pareto.png").string());
+  EXPECT_EQ(pareto.cols, 1800);
+  EXPECT_EQ(pareto.rows, 560);
   std::vector<std::string> header;
   const auto rows = read_csv(out / "sweep.csv", &header);
   EXPECT_EQ(rows.size(), expected_rows);
-  for (const char* column : {"knob", "value", "is_default", "status", "message", "identical_percent", "max_lsb",
-                             "mean_lsb", "rms_lsb", "linear_max", "linear_rms", "seconds_per_frame",
-                             "reference_seconds_per_frame", "on_chip_bits", "off_chip_bits", "delta_on_chip_bits",
-                             "delta_off_chip_bits", "meets_criterion"}) {
+  for (const char* column : {"knob", "resample_space", "value", "is_default", "status", "message",
+                             "identical_percent", "max_lsb", "mean_lsb", "rms_lsb", "linear_max", "linear_rms",
+                             "perceived_psnr_db", "visual_difference", "seconds_per_frame",
+                             "reference_seconds_per_frame", "eye_seconds_per_frame", "on_chip_bits", "off_chip_bits",
+                             "delta_on_chip_bits", "delta_off_chip_bits", "meets_criterion"}) {
     EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << column;
   }
-  // One base row per knob, all the same configuration: the same error and memory, no change of memory.
+  // One base row per knob, all the same configuration in each resample space: the same error and memory, no
+  // change of memory; every point's perceived figures and eye-model time are there.
   std::map<std::string, std::size_t> rows_of, bases_of;
-  std::string base_identical;
+  std::map<std::string, std::string> base_identical, base_on_chip;
   for (const auto& row : rows) {
     ++rows_of[row.at("knob")];
+    if (row.at("status") == "ok") {
+      EXPECT_FALSE(row.at("perceived_psnr_db").empty()) << row.at("knob");
+      EXPECT_GT(std::stod(row.at("eye_seconds_per_frame")), 0.0) << row.at("knob");
+    }
     if (row.at("is_default") != "1") continue;
     ++bases_of[row.at("knob")];
     EXPECT_EQ(row.at("status"), "ok");
     EXPECT_EQ(row.at("delta_on_chip_bits"), "0");
     EXPECT_EQ(row.at("delta_off_chip_bits"), "0");
-    if (base_identical.empty()) base_identical = row.at("identical_percent");
-    EXPECT_EQ(row.at("identical_percent"), base_identical) << row.at("knob");
+    const std::string space = row.at("resample_space");
+    if (base_identical[space].empty()) base_identical[space] = row.at("identical_percent");
+    if (base_on_chip[space].empty()) base_on_chip[space] = row.at("on_chip_bits");
+    EXPECT_EQ(row.at("identical_percent"), base_identical[space]) << row.at("knob");
+    EXPECT_EQ(row.at("on_chip_bits"), base_on_chip[space]) << row.at("knob");
   }
+  EXPECT_EQ(base_identical.size(), 2u);  // encoded, and the linear-resample-space knobs' own base
+  EXPECT_NE(base_on_chip["encoded"], base_on_chip["linear"]);
   for (const auto& [knob, n] : values_of) {
     EXPECT_EQ(rows_of[knob], n) << knob;
     EXPECT_EQ(bases_of[knob], 1u) << knob;
@@ -96,8 +114,17 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
   std::ifstream js(out / "report.json");
   const auto report = nlohmann::json::parse(js);
   EXPECT_EQ(report["parameters"]["size"][0], 24);
-  EXPECT_EQ(report["knobs"].back()["name"], "lcd_segments_per_octave");
-  EXPECT_TRUE(report["knobs"].back().contains("skipped"));
+  const auto& knobs = report["knobs"];
+  const auto lcd = std::find_if(knobs.begin(), knobs.end(),
+                                [](const auto& k) { return k["name"] == "lcd_segments_per_octave"; });
+  ASSERT_NE(lcd, knobs.end());
+  EXPECT_TRUE(lcd->contains("skipped"));
+  EXPECT_EQ(knobs.back()["name"], "eye_substeps");
+  EXPECT_TRUE(knobs.back()["eye_model"].get<bool>());
+  ASSERT_EQ(report["pareto"].size(), 3u);
+  for (const auto& front : report["pareto"]) EXPECT_FALSE(front["front"].empty()) << front["chart"];
+  EXPECT_TRUE(report.contains("linear_base"));
+  EXPECT_NE(text.find("## Pareto front"), std::string::npos);
   EXPECT_NE(r.output.find("residual_bits"), std::string::npos);  // the summary table
 }
 
@@ -227,25 +254,117 @@ TEST(Sweep, BadKnobsFailClearlyWithoutOutput) {
   }
 }
 
-namespace {
-
-// The fixed-point decoders resample in linear light too: its knobs sweep there, and say why they skip elsewhere.
-TEST(Sweep, LinearResampleSpaceKnobsSweepInLinearSpaceOnly) {
-  auto linear = small_sweep("linear_resample_frac_bits", 16, 12, 2);
-  linear.pipeline.encoder.resample_space = trm::ResampleSpace::Linear;
-  linear.values = {16, 24};
-  const auto swept = trm::cli::run_sweep(linear);
-  ASSERT_EQ(swept.knobs.size(), 1u);
-  EXPECT_TRUE(swept.knobs[0].skipped.empty());
-  ASSERT_EQ(swept.knobs[0].points.size(), 3u);  // 16, 24 and the base 32
-  EXPECT_EQ(swept.knobs[0].points[2].value, 32);
-  EXPECT_TRUE(swept.knobs[0].points[2].is_default);
-  EXPECT_TRUE(swept.knobs[0].points[1].ok());
-
+// The linear-resample-space knobs used to be skipped in an encoded-space run (the decoder does not use them there):
+// they sweep around a base of their own, the same options in linear space, which is what a run in that space has.
+TEST(Sweep, LinearResampleSpaceKnobsSweepAroundALinearBase) {
   auto encoded = small_sweep("linear_resample_frac_bits", 16, 12, 2);
-  const auto skipped = trm::cli::run_sweep(encoded);
-  ASSERT_EQ(skipped.knobs.size(), 1u);
-  EXPECT_NE(skipped.knobs[0].skipped.find("--resample-space linear"), std::string::npos) << skipped.knobs[0].skipped;
+  encoded.values = {16, 24};
+  const auto own = trm::cli::run_sweep(encoded);
+  auto linear = encoded;
+  linear.pipeline.encoder.resample_space = trm::ResampleSpace::Linear;
+  const auto direct = trm::cli::run_sweep(linear);
+  ASSERT_EQ(own.knobs.size(), 1u);
+  ASSERT_EQ(direct.knobs.size(), 1u);
+  EXPECT_TRUE(own.knobs[0].skipped.empty()) << own.knobs[0].skipped;
+  EXPECT_EQ(own.knobs[0].resample_space, trm::ResampleSpace::Linear);
+  ASSERT_TRUE(own.linear_base.has_value());
+  EXPECT_FALSE(direct.linear_base.has_value());  // the run's own base is already in linear space
+  ASSERT_EQ(own.knobs[0].points.size(), 3u);     // 16, 24 and the base 32
+  EXPECT_EQ(own.knobs[0].points[2].value, 32);
+  EXPECT_TRUE(own.knobs[0].points[2].is_default);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& a = own.knobs[0].points[i];
+    const auto& b = direct.knobs[0].points[i];
+    ASSERT_EQ(a.status, b.status) << a.value << ": " << a.message;
+    if (!a.ok()) continue;
+    EXPECT_EQ(a.codes, b.codes) << a.value;
+    EXPECT_EQ(a.differing, b.differing) << a.value;
+    EXPECT_EQ(a.max_lsb, b.max_lsb) << a.value;
+    EXPECT_EQ(a.on_chip_bits, b.on_chip_bits) << a.value;
+    EXPECT_EQ(a.delta_on_chip_bits, b.delta_on_chip_bits) << a.value;
+  }
+  // The linear-space decoder is another decoder (linear line buffers, no EOTF ROM), and the knob sets its lin(E) ROM.
+  EXPECT_NE(own.linear_base->on_chip_bits, own.base.on_chip_bits);
+  ASSERT_TRUE(own.knobs[0].points[1].ok()) << own.knobs[0].points[1].message;
+  EXPECT_LT(own.knobs[0].points[1].on_chip_bits, own.knobs[0].points[2].on_chip_bits);
 }
 
-}  // namespace
+// Brute force: a point is on the front when no other point has cost <= and error <= with one of them <.
+TEST(Sweep, ParetoFrontIsEveryUndominatedPoint) {
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int n = 1 + trial % 17;
+    std::vector<double> cost(n), error(n);
+    for (int i = 0; i < n; ++i) {
+      cost[i] = rng.uniform(0, 6);   // few distinct values: ties in cost, in error and whole points
+      error[i] = rng.uniform(0, 6);
+    }
+    std::vector<std::size_t> expected;
+    for (int i = 0; i < n; ++i) {
+      bool dominated = false;
+      for (int j = 0; j < n; ++j) {
+        dominated = dominated || (cost[j] <= cost[i] && error[j] <= error[i] &&
+                                  (cost[j] < cost[i] || error[j] < error[i]));
+      }
+      if (!dominated) expected.push_back(static_cast<std::size_t>(i));
+    }
+    std::vector<std::size_t> front = trm::cli::pareto_front(cost, error);
+    for (std::size_t k = 1; k < front.size(); ++k) EXPECT_LE(cost[front[k - 1]], cost[front[k]]);
+    std::sort(front.begin(), front.end());
+    EXPECT_EQ(front, expected) << "trial " << trial;
+  }
+  EXPECT_THROW((void)trm::cli::pareto_front({1.0}, {}), std::invalid_argument);
+}
+
+// The eye model's sub-steps: the base decoder watched at S against the reference decoder at the exact eye. The exact
+// eye itself leaves nothing (a value the reference is made with), the error falls as S grows, values that do not
+// divide the exact eye's sub-steps are rejected, and the decoder's own figures stay the base's.
+TEST(Sweep, EyeSubstepsConvergeToTheExactEye) {
+  // Wide enough that the fastest disc travels pixels per frame (speeds are fractions of the view size): at 48x40 the
+  // eye's travel within a lit OLED window stays inside one pixel interval, where every sub-step count is exact.
+  auto o = small_sweep("eye_substeps", 240, 32, 4);
+  o.values = {1, 3, 4, 32, trm::cli::kExactEyeSubsteps};
+  const auto result = trm::cli::run_sweep(o);
+  ASSERT_EQ(result.knobs.size(), 1u);
+  const auto& points = result.knobs[0].points;
+  ASSERT_EQ(points.size(), 6u);  // 1, 3, 4, 16 (base), 32, 256
+  EXPECT_EQ(points[1].status, "rejected");
+  EXPECT_NE(points[1].message.find("does not divide"), std::string::npos) << points[1].message;
+  EXPECT_TRUE(points[3].is_default);
+  EXPECT_NE(result.target_velocity_deg_s, 0.0);  // discs move: the eye pursues
+  const std::vector<const trm::cli::SweepPoint*> ok = {&points[0], &points[2], &points[3], &points[4]};
+  for (std::size_t i = 1; i < ok.size(); ++i) {
+    EXPECT_LT(ok[i]->visual_difference, ok[i - 1]->visual_difference) << ok[i]->value;
+    EXPECT_GT(ok[i]->perceived_psnr_db, ok[i - 1]->perceived_psnr_db) << ok[i]->value;
+  }
+  EXPECT_GT(ok.front()->visual_difference, 0.0);
+  // At the exact eye's own sub-steps only the base decoder's difference from the reference is left: none here.
+  EXPECT_EQ(result.base.differing, 0);
+  EXPECT_EQ(points[5].visual_difference, 0.0);
+  EXPECT_TRUE(std::isinf(points[5].perceived_psnr_db));
+  for (const auto& p : points) {
+    if (!p.ok()) continue;
+    EXPECT_EQ(p.codes, result.base.codes);
+    EXPECT_EQ(p.on_chip_bits, result.base.on_chip_bits);
+    EXPECT_EQ(p.delta_off_chip_bits, 0);
+    EXPECT_GT(p.eye_seconds_per_frame, 0.0);
+  }
+}
+
+// A decoder knob's perceived error is its decoder's against the reference's, seen by the same eye: nothing where the
+// codes agree, and more as the residual store narrows.
+TEST(Sweep, PerceivedErrorFollowsTheDecodersCodes) {
+  auto o = small_sweep("residual_bits", 48, 40, 4);
+  o.values = {6, 12};
+  const auto result = trm::cli::run_sweep(o);
+  const auto& points = result.knobs.at(0).points;
+  ASSERT_EQ(points.size(), 3u);  // 6, 12, the base 30
+  for (const auto& p : points) ASSERT_TRUE(p.ok()) << p.value << ": " << p.message;
+  EXPECT_EQ(points[2].differing, 0);
+  EXPECT_TRUE(std::isinf(points[2].perceived_psnr_db));
+  EXPECT_EQ(points[2].visual_difference, 0.0);
+  EXPECT_GT(points[0].differing, points[1].differing);
+  EXPECT_LT(points[0].perceived_psnr_db, points[1].perceived_psnr_db);
+  EXPECT_TRUE(std::isfinite(points[1].perceived_psnr_db));
+  EXPECT_GT(points[0].visual_difference, 0.0);
+}

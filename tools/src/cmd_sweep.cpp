@@ -1,6 +1,6 @@
 // `trm sweep`: error against run time and memory for every approximation knob of the fixed-point decoder
-// (DESIGN §7). Writes sweep.csv, sweep.md, sweep_<knob>.png and report.json into one output directory; with
-// --shard K/N one part of the points into a part directory, which --merge joins (sweep_shard.hpp).
+// (DESIGN §7). Writes sweep.csv, sweep.md, sweep_<knob>.png, sweep_pareto.png and report.json into one output
+// directory; with --shard K/N one part of the points into a part directory, which --merge joins (sweep_shard.hpp).
 #include "commands.hpp"
 #include "output_dir.hpp"
 #include "run_report.hpp"
@@ -138,13 +138,14 @@ std::vector<GivenOption> merged_command_options(const CLI::App& cmd, const std::
 
 std::string knob_listing() {
   std::ostringstream s;
-  const FixedDecoderConfig base;
+  const SweepConfig base;
   for (const auto& k : sweep_knobs()) {
     s << "  " << std::left << std::setw(30) << k.name << std::right << " default " << std::setw(5) << k.get(base)
       << "  values";
     for (int v : k.values) s << " " << v;
     s << "\n      " << k.description << "; cost: " << k.cost
-      << (k.oled && k.lcd ? "" : k.oled ? " (OLED panels only)" : " (LCD panel only)") << "\n";
+      << (k.oled && k.lcd ? "" : k.oled ? " (OLED panels only)" : " (LCD panel only)")
+      << (k.linear_space_only ? " (swept around a --resample-space linear base)" : "") << "\n";
   }
   return s.str();
 }
@@ -161,6 +162,8 @@ void write_outputs(OutputDir& dir, const SweepResult& result) {
     write_sweep_plot(dir.file(name), result, knob);
     ++plots;
   }
+  write_pareto_plot(dir.file("sweep_pareto.png"), result);
+  ++plots;
   dir.write_text("report.json", sweep_json(result).dump(2) + "\n");
   dir.commit();
   std::cout << "trm sweep: " << result.knobs.size() << " knob(s)\n"
@@ -184,7 +187,7 @@ int run(const SweepCli& cli, const std::vector<GivenOption>& part_options) {
   }
   dir.write_text(kSweepPartFile, sweep_part_text(result, part_options, TRM_VERSION));
   dir.commit();
-  std::size_t points = options.shard.owns(0) ? 1 : 0;
+  std::size_t points = (options.shard.owns(0) ? 1 : 0) + (result.linear_base ? 1 : 0);
   for (const auto& k : result.knobs) points += k.points.size();
   std::cout << "trm sweep: shard " << options.shard.index << "/" << options.shard.count << ": " << points << " of "
             << sweep_point_count(plan_sweep(options)) << " points; wrote " << dir.target().string() << "/ ("
@@ -211,9 +214,9 @@ int merge(const CLI::App& cmd, const SweepCli& cli) {
 void register_sweep(CLI::App& app, Action& action) {
   auto cli = std::make_shared<SweepCli>();
   CLI::App* cmd = app.add_subcommand(
-      "sweep", "Sweep every approximation knob of the fixed-point decoder alone and report error against the "
-               "reference vs decode time and memory (default: discs, 270x300, 12 frames, r = 1/2, vive OLED; a few "
-               "minutes on two cores)");
+      "sweep", "Sweep every approximation knob (the fixed-point decoder's, the eye model's) alone and report "
+               "error against the reference vs run time and memory, with the Pareto fronts (default: discs, 270x300, "
+               "12 frames, r = 1/2, vive OLED; a few minutes on two cores)");
   define_sweep_options(cmd, cli.get());
   cmd->callback([cli, cmd, &action] {
     if (!cli->merge.empty()) {

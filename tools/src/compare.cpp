@@ -214,6 +214,26 @@ const std::vector<Column>& columns() {
 
 }  // namespace
 
+PursuedTarget pursued_target(const FrameSource& source) {
+  PursuedTarget target;
+  const Motion motion = source.motion(0);
+  target.velocity_px_s = motion.global_velocity_px_s[0];
+  target.scan_line = source.height() / 2;
+  target.right = source.width();
+  if (target.velocity_px_s == 0.0) {
+    for (const MotionObject& object : motion.objects) {
+      if (std::abs(object.velocity_px_s[0]) > std::abs(target.velocity_px_s)) {
+        target.velocity_px_s = object.velocity_px_s[0];
+        const double centre = object.bounds.y + 0.5 * object.bounds.height;
+        target.scan_line = std::clamp(static_cast<int>(centre), 0, source.height() - 1);
+        target.left = object.bounds.x;
+        target.right = object.bounds.x + object.bounds.width;
+      }
+    }
+  }
+  return target;
+}
+
 std::string figure_name(const std::string& method) {
   std::string name = method;
   std::replace(name.begin(), name.end(), ':', '-');
@@ -272,22 +292,10 @@ CompareResult run_compare(const CompareOptions& options,
   // through its centre at t = 0. Inputs without known motion are watched at a fixed gaze.
   const std::unique_ptr<FrameSource> source = options.pipeline.open_source();
   PipelineOptions shown = options.pipeline;  // what every method runs on: the scene at the asked speed
-  const Motion motion = source->motion(0);
-  double target_px_s = motion.global_velocity_px_s[0];
-  result.scan_line = source->height() / 2;
-  // The target's columns at t = 0: its bounds, or the whole line for a global motion.
-  double target_left = 0.0, target_right = source->width();
-  if (target_px_s == 0.0) {
-    for (const MotionObject& object : motion.objects) {
-      if (std::abs(object.velocity_px_s[0]) > std::abs(target_px_s)) {
-        target_px_s = object.velocity_px_s[0];
-        const double centre = object.bounds.y + 0.5 * object.bounds.height;
-        result.scan_line = std::clamp(static_cast<int>(centre), 0, source->height() - 1);
-        target_left = object.bounds.x;
-        target_right = object.bounds.x + object.bounds.width;
-      }
-    }
-  }
+  const PursuedTarget target = pursued_target(*source);
+  double target_px_s = target.velocity_px_s;
+  result.scan_line = target.scan_line;
+  const double target_left = target.left, target_right = target.right;
   const Viewer viewer = options.ppd ? custom_viewer(*options.ppd) : viewer_preset(options.viewer);
   if (options.speed_deg_s) {
     if (target_px_s == 0.0) {

@@ -81,6 +81,15 @@ struct CompareResult {
   std::vector<cv::Mat> figures;  // per method: the Fig. 12 view (xt_figure.hpp), RGB CV_8UC3; empty: no x-t image
 };
 
+// The target an eye model pursues in a source at t = 0: the scene's global motion, else its fastest object, along the
+// row through that object's centre; no motion (inputs, still scenes): velocity 0, the middle row, the whole line.
+struct PursuedTarget {
+  double velocity_px_s = 0.0;          // horizontal, signed
+  int scan_line = 0;
+  double left = 0.0, right = 0.0;      // the target's columns at t = 0
+};
+PursuedTarget pursued_target(const FrameSource& source);
+
 // The file name of a method's figure: "fig12_" + the method with ':' as '-' + ".png".
 std::string figure_name(const std::string& method);
 

@@ -1,5 +1,6 @@
 #include "sweep.hpp"
 
+#include "compare.hpp"
 #include "hw_report.hpp"
 #include "vectors.hpp"
 
@@ -9,6 +10,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -32,8 +35,8 @@ SweepKnob field_knob(std::string name, std::string description, std::string cost
   k.values = std::move(values);
   k.oled = oled;
   k.lcd = lcd;
-  k.get = [field](const FixedDecoderConfig& c) { return c.*field; };
-  k.set = [field](FixedDecoderConfig& c, int v) { c.*field = v; };
+  k.get = [field](const SweepConfig& c) { return c.decoder.*field; };
+  k.set = [field](SweepConfig& c, int v) { c.decoder.*field = v; };
   return k;
 }
 
@@ -43,7 +46,8 @@ std::vector<SweepKnob> make_knobs() {
       "linear_frac_bits", "linear light I, L, alpha, beta: uQ1.F (the residual store follows when it is lossless)",
       "ROM words, frame stores (residual, LCD x_{t-1}), arithmetic", {16, 18, 20, 21, 22, 23, 24, 26, 28},
       &FixedDecoderConfig::linear_frac_bits);
-  linear.set = [](FixedDecoderConfig& c, int v) {
+  linear.set = [](SweepConfig& s, int v) {
+    FixedDecoderConfig& c = s.decoder;
     // The default residual store is lossless (sQ2.F): keep it so, so that this knob measures linear light alone.
     if (c.residual.frac_bits == c.linear_frac_bits) c.residual.frac_bits = v;
     c.linear_frac_bits = v;
@@ -57,13 +61,13 @@ std::vector<SweepKnob> make_knobs() {
                              &FixedDecoderConfig::gaussian_line_frac_bits));
   SweepKnob linear_resample = field_knob(
       "linear_resample_frac_bits",
-      "linear resample space: lin(E) ROM words and D's input uQ1.P (--resample-space linear only)",
+      "linear resample space: lin(E) ROM words and D's input uQ1.P (swept in that space)",
       "ROM (lin(E) per link code), line buffer (vertical Gaussian)", {16, 20, 24, 26, 28, 30, 32, 36, 40},
       &FixedDecoderConfig::linear_resample_frac_bits);
   linear_resample.linear_space_only = true;
   knobs.push_back(std::move(linear_resample));
   SweepKnob linear_taps = field_knob("linear_gaussian_tap_frac_bits",
-                                     "linear resample space: D taps uQ0.T, summing to 2^T (--resample-space linear only)",
+                                     "linear resample space: D taps uQ0.T, summing to 2^T (swept in that space)",
                                      "arithmetic width only", {8, 12, 16, 20, 24, 28, 30},
                                      &FixedDecoderConfig::linear_gaussian_tap_frac_bits);
   linear_taps.linear_space_only = true;
@@ -81,8 +85,10 @@ std::vector<SweepKnob> make_knobs() {
   residual.description = "residual store rho: N bits, sQ2.(N - 2) (as --residual-bits)";
   residual.cost = "frame store (residual)";
   residual.values = {4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30};
-  residual.get = [](const FixedDecoderConfig& c) { return c.residual.width(); };
-  residual.set = [](FixedDecoderConfig& c, int v) { c.residual = residual_format_of_bits(v, c.linear_frac_bits); };
+  residual.get = [](const SweepConfig& c) { return c.decoder.residual.width(); };
+  residual.set = [](SweepConfig& c, int v) {
+    c.decoder.residual = residual_format_of_bits(v, c.decoder.linear_frac_bits);
+  };
   knobs.push_back(std::move(residual));
   knobs.push_back(field_knob("luma_weight_frac_bits", "Eq. 5 Rec. 709 luma weights uQ0.W, summing to 2^W",
                              "arithmetic width only", {8, 10, 12, 14, 16, 20, 24, 28},
@@ -110,6 +116,25 @@ std::vector<SweepKnob> make_knobs() {
   knobs.push_back(field_knob("lcd_segments_per_octave", "LCD target m = x^(1/gamma) LUT: segments per octave",
                              "ROM (LCD target)", {8, 16, 32, 64, 128, 256, 512, 1024, 2048},
                              &FixedDecoderConfig::lcd_segments_per_octave, false, true));
+  // The liquid crystal has no time step to sweep: each frame is its exact exponential segment (lc_response.hpp).
+  // What is sampled within a frame is its light, by the eye's sub-steps (each integrates the light exactly and
+  // takes the eye at the step's middle), so on an LCD this knob is also the sub-frame sampling of the LC light.
+  SweepKnob eye;
+  eye.name = "eye_substeps";
+  eye.description = "eye model sub-frame steps S: the eye's motion and (LCD) the LC light's sampling within a frame; "
+                    "S divides " + std::to_string(kExactEyeSubsteps);
+  eye.cost = "eye-model run time (no hardware)";
+  eye.values = {1, 2, 4, 8, 16, 32, 64, 128};
+  eye.eye_model = true;
+  eye.get = [](const SweepConfig& c) { return c.eye_substeps; };
+  eye.set = [](SweepConfig& c, int v) {
+    if (v < 1 || kExactEyeSubsteps % v != 0) {
+      throw std::invalid_argument("eye_substeps " + std::to_string(v) + " does not divide the exact eye's " +
+                                  std::to_string(kExactEyeSubsteps) + " sub-steps");
+    }
+    c.eye_substeps = v;
+  };
+  knobs.push_back(std::move(eye));
   return knobs;
 }
 
@@ -122,11 +147,10 @@ std::string knob_list() {
   return list;
 }
 
-// Why a knob does nothing for this panel and resample space, or empty when it applies.
-std::string not_applicable(const SweepKnob& knob, const Panel& panel, ResampleSpace space) {
+// Why a knob does nothing for this panel, or empty when it applies.
+std::string not_applicable(const SweepKnob& knob, const Panel& panel) {
   if (panel.has_history() && !knob.lcd) return "not used with the LCD panel";
   if (!panel.has_history() && !knob.oled) return "used with the LCD panel only";
-  if (knob.linear_space_only && space != ResampleSpace::Linear) return "used with --resample-space linear only";
   return "";
 }
 
@@ -191,22 +215,58 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Decodes the recorded sequence `repeats` times with a fresh streaming decoder of this configuration.
-SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, const SweepOptions& options,
-                    const std::function<void()>& sequence_done) {
+// One encoded sequence with its reference decoding, its base point and what the eye makes of the reference.
+struct Sequence {
+  Recording rec;
+  SweepConfig base_config;
+  SweepPoint base;
+  std::vector<ShownFrame> base_shown;       // the base decoder's frames of eye 0
+  PerceivedSequence reference_seen;         // the reference decoder's, at the base eye
+};
+
+std::vector<ShownFrame> reference_shown(const Recording& rec) {
+  std::vector<ShownFrame> shown;
+  for (const RecordedView& view : rec.views) {
+    if (view.sent.meta.eye == 0) shown.push_back({view.sent.meta.index, view.drive_codes});
+  }
+  return shown;
+}
+
+// The perceived error and eye-model time of `shown` at `substeps` against `reference`, perceived `runs` times.
+void watch(SweepPoint& p, const std::vector<ShownFrame>& shown, int substeps, const PerceivedSequence& reference,
+           const EyeSetup& eye, int runs) {
+  PerceivedSequence seen;
+  double fastest = std::numeric_limits<double>::infinity();
+  for (int run = 0; run < runs; ++run) {
+    const auto start = Clock::now();
+    seen = perceive(shown, eye, substeps);
+    fastest = std::min(fastest, seconds_since(start));
+  }
+  p.eye_seconds_per_frame = fastest / static_cast<double>(shown.size());
+  const PerceivedError error = perceived_error(seen, reference, eye);
+  p.perceived_psnr_db = error.psnr_db;
+  p.visual_difference = error.visual_difference;
+}
+
+// Decodes the recorded sequence `repeats` times with a fresh streaming decoder of this configuration, and watches
+// the first decoding at the configuration's eye against the reference's. `shown_out`: eye 0's frames, when given.
+SweepPoint evaluate(const SweepConfig& config, const Sequence& seq, const EyeSetup& eye, const SweepOptions& options,
+                    const std::function<void()>& sequence_done, std::vector<ShownFrame>* shown_out = nullptr) {
+  const Recording& rec = seq.rec;
   SweepPoint p;
-  p.residual_format = config.residual.to_string();
-  const double levels = std::ldexp(1.0, config.decoder.output_bits) - 1.0;
+  p.residual_format = config.decoder.residual.to_string();
+  const double levels = std::ldexp(1.0, config.decoder.decoder.output_bits) - 1.0;
   CodeAgreement codes;
   double sum_sq_linear = 0.0;
   std::int64_t linear_samples = 0;
+  std::vector<ShownFrame> shown;
   // Decode time of every view in every repeat: the median per view over the repeats, averaged over the views.
   std::vector<std::vector<double>> view_seconds(rec.views.size());
   for (int repeat = 0; repeat < options.repeats; ++repeat) {
     const auto setup_start = Clock::now();
     std::unique_ptr<HeadsetDecoder> decoder;
     try {
-      decoder = make_decoder("fixed", config);  // the hardware model
+      decoder = make_decoder("fixed", config.decoder);  // the hardware model
     } catch (const std::invalid_argument& e) {
       p.status = "rejected";
       p.message = e.what();
@@ -245,6 +305,7 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
       sum_sq_linear += cv::norm(decoded.emitted_linear, view.emitted, cv::NORM_L2SQR);
       linear_samples += static_cast<std::int64_t>(view.emitted.total()) * view.emitted.channels();
       p.drive_max_lsb = std::max(p.drive_max_lsb, cv::norm(decoded.drive, view.drive, cv::NORM_INF) * levels);
+      if (view.sent.meta.eye == 0) shown.push_back({view.sent.meta.index, decoded.drive_codes});
     }
     p.repeat_seconds_per_frame.push_back(decode_seconds / static_cast<double>(rec.views.size()));
     if (sequence_done) sequence_done();
@@ -262,6 +323,10 @@ SweepPoint evaluate(const FixedDecoderConfig& config, const Recording& rec, cons
   }
   p.seconds_per_frame /= static_cast<double>(view_seconds.size());
   p.min_seconds_per_frame /= static_cast<double>(view_seconds.size());
+  if (!seq.reference_seen.pairs.empty() || !seq.reference_seen.xt.empty()) {
+    watch(p, shown, config.eye_substeps, seq.reference_seen, eye, 1);
+  }
+  if (shown_out) *shown_out = std::move(shown);
   return p;
 }
 
@@ -292,11 +357,20 @@ void SweepOptions::validate() const {
   if (repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
   if (hw_size.width < 1 || hw_size.height < 1) throw std::invalid_argument("--hw-size must be WxH with W, H >= 1");
   pipeline.validate();
-  // The recording keeps every view's codes, drive codes, drive and emitted light beside a pipeline run.
+  // The recording keeps every view's codes, drive codes, drive and emitted light beside a pipeline run (twice when
+  // the linear-resample-space knobs sweep around their own base).
   const std::int64_t frames = pipeline.frames > 0 ? pipeline.frames : pipeline.default_frames;
   const std::int64_t views = frames * (pipeline.encoder.stereo ? 2 : 1);
-  require_memory("for the pipeline and " + std::to_string(views) + " recorded views",
-                 run_bytes_per_pixel(pipeline) + kRecordedViewBytesPerPixel * static_cast<double>(views),
+  bool two_sequences = false;
+  for (const auto& knob : sweep_knobs()) {
+    const bool asked = knobs.empty() || std::find(knobs.begin(), knobs.end(), knob.name) != knobs.end();
+    two_sequences = two_sequences ||
+                    (asked && knob.linear_space_only && pipeline.encoder.resample_space != ResampleSpace::Linear);
+  }
+  require_memory("for the pipeline and " + std::to_string(views) + " recorded views" +
+                     (two_sequences ? " in each of two resample spaces" : ""),
+                 run_bytes_per_pixel(pipeline) +
+                     kRecordedViewBytesPerPixel * static_cast<double>(views) * (two_sequences ? 2.0 : 1.0),
                  cv::Size(pipeline.width, pipeline.height));
   const std::int64_t points = sweep_point_count(plan_sweep(*this));
   if (shard.count > points) {
@@ -320,7 +394,13 @@ const SweepPoint* SweepKnobResult::cheapest_meeting() const {
 }
 
 std::vector<SweepPlanKnob> plan_sweep(const SweepOptions& options) {
-  const FixedDecoderConfig base = fixed_config_of(options.pipeline);
+  const ResampleSpace run_space = options.pipeline.encoder.resample_space;
+  SweepConfig base;
+  base.decoder = fixed_config_of(options.pipeline);
+  PipelineOptions linear_pipeline = options.pipeline;
+  linear_pipeline.encoder.resample_space = ResampleSpace::Linear;
+  SweepConfig linear_base = base;
+  linear_base.decoder = fixed_config_of(linear_pipeline);
   std::vector<SweepPlanKnob> plan;
   for (const auto& knob : sweep_knobs()) {
     const bool asked = options.knobs.empty() ||
@@ -329,8 +409,15 @@ std::vector<SweepPlanKnob> plan_sweep(const SweepOptions& options) {
     SweepPlanKnob k;
     k.knob = &knob;
     k.default_value = knob.get(base);
-    k.skipped = not_applicable(knob, options.pipeline.panel, options.pipeline.encoder.resample_space);
+    k.resample_space = run_space;
+    k.skipped = not_applicable(knob, options.pipeline.panel);
     if (k.skipped.empty()) {
+      // A linear-resample-space knob in an encoded-space run sweeps around the same options in linear space.
+      k.linear_base = knob.linear_space_only && run_space != ResampleSpace::Linear;
+      if (k.linear_base) {
+        k.resample_space = ResampleSpace::Linear;
+        k.default_value = knob.get(linear_base);
+      }
       std::set<int> set(options.values.empty() ? knob.values.begin() : options.values.begin(),
                         options.values.empty() ? knob.values.end() : options.values.end());
       set.insert(k.default_value);
@@ -341,10 +428,18 @@ std::vector<SweepPlanKnob> plan_sweep(const SweepOptions& options) {
   return plan;
 }
 
+bool sweep_has_linear_base(const std::vector<SweepPlanKnob>& plan) {
+  return std::any_of(plan.begin(), plan.end(), [](const SweepPlanKnob& k) { return k.linear_base; });
+}
+
+bool sweep_is_point(const SweepPlanKnob& planned, int value) {
+  return planned.knob->eye_model || value != planned.default_value;
+}
+
 std::int64_t sweep_point_count(const std::vector<SweepPlanKnob>& plan) {
-  std::int64_t count = 1;  // the base point
+  std::int64_t count = sweep_has_linear_base(plan) ? 2 : 1;  // the base point, and the linear base
   for (const SweepPlanKnob& k : plan) {
-    if (!k.values.empty()) count += static_cast<std::int64_t>(k.values.size()) - 1;
+    for (int value : k.values) count += sweep_is_point(k, value) ? 1 : 0;
   }
   return count;
 }
@@ -353,16 +448,32 @@ void finish_sweep(SweepResult& result) {
   const SweepOptions& options = result.options;
   for (SweepKnobResult& kr : result.knobs) {
     if (!kr.skipped.empty()) continue;
-    SweepPoint base = result.base;
-    base.value = kr.default_value;
-    base.is_default = true;
-    kr.points.push_back(std::move(base));
+    const bool linear = kr.knob->linear_space_only && result.linear_base.has_value();
+    const SweepPoint& base = linear ? *result.linear_base : result.base;
+    if (kr.knob->eye_model) {
+      // The decoder is the base's, with its figures (one shard's base for every part); the eye is the point's own.
+      for (SweepPoint& p : kr.points) {
+        if (!p.ok()) continue;
+        SweepPoint watched = base;
+        watched.value = p.value;
+        watched.is_default = p.is_default;
+        watched.perceived_psnr_db = p.perceived_psnr_db;
+        watched.visual_difference = p.visual_difference;
+        watched.eye_seconds_per_frame = p.eye_seconds_per_frame;
+        p = std::move(watched);
+      }
+    } else {
+      SweepPoint at_base = base;
+      at_base.value = kr.default_value;
+      at_base.is_default = true;
+      kr.points.push_back(std::move(at_base));
+    }
     std::sort(kr.points.begin(), kr.points.end(),
               [](const SweepPoint& a, const SweepPoint& b) { return a.value < b.value; });
     for (SweepPoint& p : kr.points) {
       if (!p.ok()) continue;
-      p.delta_on_chip_bits = p.on_chip_bits - result.base.on_chip_bits;
-      p.delta_off_chip_bits = p.off_chip_bits - result.base.off_chip_bits;
+      p.delta_on_chip_bits = p.on_chip_bits - base.on_chip_bits;
+      p.delta_off_chip_bits = p.off_chip_bits - base.off_chip_bits;
     }
     if (!options.values.empty()) {
       // Asked-for values that all fail leave nothing to report: an error, with the first reason.
@@ -384,58 +495,101 @@ void finish_sweep(SweepResult& result) {
 SweepResult run_sweep(const SweepOptions& options,
                       const std::function<void(std::int64_t done, std::int64_t total)>& progress) {
   options.validate();
-  const FixedDecoderConfig base = fixed_config_of(options.pipeline);
-  (void)make_decoder("fixed", base);  // an unusable base configuration fails the whole sweep, with its message
+  const Panel& panel = options.pipeline.panel;
+  SweepConfig base;
+  base.decoder = fixed_config_of(options.pipeline);
+  (void)make_decoder("fixed", base.decoder);  // an unusable base configuration fails the whole sweep, with its message
+  PipelineOptions linear_pipeline = options.pipeline;
+  linear_pipeline.encoder.resample_space = ResampleSpace::Linear;
+  SweepConfig linear_base = base;
+  linear_base.decoder = fixed_config_of(linear_pipeline);
 
   SweepResult result;
   result.options = options;
   const std::vector<SweepPlanKnob> plan = plan_sweep(options);
   const SweepShard& shard = options.shard;
-  // The sequence decodes this shard makes: its points (numbered as SweepShard numbers them) and the base's.
-  std::int64_t decodes = 0;
-  const std::int64_t points = sweep_point_count(plan);
-  for (std::int64_t number = 0; number < points; ++number) decodes += shard.owns(number) ? 1 : 0;
+  const bool has_linear_base = sweep_has_linear_base(plan);
+  const std::int64_t linear_base_number = 1;
+  // What this shard evaluates: its points (numbered as SweepShard numbers them), the sequences they decode or watch
+  // (every shard that needs a base computes its output, eye points watching it), and the decodes that makes.
+  bool needs_encoded = shard.owns(0), needs_linear = has_linear_base && shard.owns(linear_base_number);
+  bool any_eye = false;
+  std::int64_t decodes = (shard.owns(0) ? 1 : 0) + (needs_linear ? 1 : 0);
+  {
+    std::int64_t number = has_linear_base ? linear_base_number : 0;
+    for (const SweepPlanKnob& planned : plan) {
+      for (int value : planned.values) {
+        if (!sweep_is_point(planned, value) || !shard.owns(++number)) continue;
+        (planned.linear_base ? needs_linear : needs_encoded) = true;
+        if (planned.knob->eye_model) any_eye = true;
+        else ++decodes;
+      }
+    }
+  }
 
   const auto start = Clock::now();
-  const Recording rec = record_reference(options.pipeline);
-  result.size = rec.size;
-  result.reduced = rec.reduced;
-  result.views = static_cast<std::int64_t>(rec.views.size());
-  result.reference_seconds_per_frame = rec.reference_seconds / static_cast<double>(result.views);
-  result.recording_hash = recording_hash(rec);
-  const std::int64_t total = result.views * (1 + decodes * options.repeats);
-  std::int64_t done = result.views;
+  const PursuedTarget target = pursued_target(*options.pipeline.open_source());
+  // The encoded sequence is recorded by every shard: its size sets the eye, its hash ties the parts together.
+  Sequence encoded{record_reference(options.pipeline), base, {}, {}, {}};
+  std::optional<Sequence> linear;
+  if (needs_linear) linear = Sequence{record_reference(linear_pipeline), linear_base, {}, {}, {}};
+  const int recorded = linear ? 2 : 1;
+  result.size = encoded.rec.size;
+  result.reduced = encoded.rec.reduced;
+  result.views = static_cast<std::int64_t>(encoded.rec.views.size());
+  result.reference_seconds_per_frame = encoded.rec.reference_seconds / static_cast<double>(result.views);
+  result.recording_hash = recording_hash(encoded.rec);
+  if (linear) result.linear_recording_hash = recording_hash(linear->rec);
+  const EyeSetup eye = eye_setup(panel, options.pipeline.output_bits, options.pipeline.refresh_hz,
+                                 target.velocity_px_s, target.scan_line, result.size.height);
+  result.pixels_per_degree = eye.viewer.pixels_per_degree;
+  result.target_velocity_deg_s = eye.target_velocity_deg_s;
+  result.eye_velocity_deg_s = eye.eye_velocity_deg_s;
+  result.scan_line = eye.scan_line;
+  const std::int64_t total = result.views * (recorded + decodes * options.repeats);
+  std::int64_t done = result.views * recorded;
   const auto sequence_done = [&] {
     done += result.views;
     if (progress) progress(done, total);
   };
   if (progress) progress(done, total);
 
-  // One untimed decode of the sequence first, so that the first timed point is not timed on cold caches.
-  (void)evaluate(base, rec, [&] {
-    SweepOptions once = options;
-    once.repeats = 1;
-    return once;
-  }(), {});
-  if (shard.owns(0)) {
-    result.base = evaluate(base, rec, options, sequence_done);
-    result.base.is_default = true;
-    if (!result.base.ok()) {
-      throw std::runtime_error(std::string("the base configuration failed: ").append(result.base.message));
+  // Each needed sequence's base: one untimed decode of the sequence first, so that nothing is timed on cold caches,
+  // which also gives the base's shown frames; then its base point, timed, in the shard that owns it.
+  SweepOptions once = options;
+  once.repeats = 1;
+  for (Sequence* seq : {needs_encoded ? &encoded : nullptr, linear ? &*linear : nullptr}) {
+    if (!seq) continue;
+    seq->reference_seen = perceive(reference_shown(seq->rec), eye, seq->base_config.eye_substeps);
+    const SweepPoint warm = evaluate(seq->base_config, *seq, eye, once, {}, &seq->base_shown);
+    if (!warm.ok()) throw std::runtime_error(std::string("the base configuration failed: ").append(warm.message));
+    const bool owned = seq == &encoded ? shard.owns(0) : shard.owns(linear_base_number);
+    if (!owned) continue;
+    seq->base = evaluate(seq->base_config, *seq, eye, options, sequence_done);
+    seq->base.is_default = true;
+    if (!seq->base.ok()) {
+      throw std::runtime_error(std::string("the base configuration failed: ").append(seq->base.message));
     }
   }
+  if (shard.owns(0)) result.base = encoded.base;
+  if (linear && shard.owns(linear_base_number)) result.linear_base = linear->base;
+  // The reference decoder's output seen by the exact eye, for the eye-model knobs (made when one is swept here).
+  std::optional<PerceivedSequence> exact_seen;
+  if (any_eye) exact_seen = perceive(reference_shown(encoded.rec), eye, kExactEyeSubsteps);
 
-  std::int64_t number = 0;  // the base point's
+  std::int64_t number = has_linear_base ? linear_base_number : 0;  // the last base point's
   for (const SweepPlanKnob& planned : plan) {
     const SweepKnob& knob = *planned.knob;
     SweepKnobResult kr;
     kr.knob = &knob;
     kr.default_value = planned.default_value;
+    kr.resample_space = planned.resample_space;
     kr.skipped = planned.skipped;
     for (int value : planned.values) {
-      if (value == kr.default_value || !shard.owns(++number)) continue;
+      if (!sweep_is_point(planned, value) || !shard.owns(++number)) continue;
+      const Sequence& seq = planned.linear_base ? *linear : encoded;
       SweepPoint p;
-      FixedDecoderConfig config = base;
+      SweepConfig config = seq.base_config;
       bool set = true;
       try {
         knob.set(config, value);
@@ -444,13 +598,20 @@ SweepResult run_sweep(const SweepOptions& options,
         p.message = e.what();
         set = false;
       }
-      if (set) p = evaluate(config, rec, options, sequence_done);
-      if (!p.ok()) {
-        done += result.views * options.repeats -
-                static_cast<std::int64_t>(p.repeat_seconds_per_frame.size()) * result.views;
-        if (progress) progress(done, total);
+      if (knob.eye_model) {
+        // The decoder is the base's (finish_sweep() gives the point its figures); the eye is the knob's, held to
+        // the exact eye.
+        if (set) watch(p, seq.base_shown, config.eye_substeps, *exact_seen, eye, options.repeats);
+        p.is_default = value == kr.default_value;
+      } else {
+        if (set) p = evaluate(config, seq, eye, options, sequence_done);
+        if (!p.ok()) {
+          done += result.views * options.repeats -
+                  static_cast<std::int64_t>(p.repeat_seconds_per_frame.size()) * result.views;
+          if (progress) progress(done, total);
+        }
+        p.is_default = false;
       }
-      p.is_default = false;
       p.value = value;
       kr.points.push_back(std::move(p));
     }

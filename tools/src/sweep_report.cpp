@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iomanip>
 #include <sstream>
 
@@ -41,6 +42,8 @@ std::string percent_text(const SweepPoint& p) {
   if (p.differing == 0) return "100 %";
   return fixed_text(std::floor(p.identical_percent * 1e4) / 1e4, 4) + " %";
 }
+
+std::string db_text(double db) { return std::isinf(db) ? std::string("exact") : fixed_text(db, 2); }
 
 std::string kib(std::int64_t bits) { return fixed_text(static_cast<double>(bits) / 8.0 / 1024.0, 1); }
 
@@ -99,15 +102,105 @@ plot::Axis spread_axis(const std::vector<double>& values, std::string label) {
   return a;
 }
 
+// ---- Pareto fronts ----
+
+// A point of one knob, as a candidate of a front.
+struct Candidate {
+  const SweepKnobResult* knob = nullptr;
+  const SweepPoint* point = nullptr;
+};
+
+// Accepted points of the decoder knobs swept in `space` (the base once) or of the eye-model knobs.
+std::vector<Candidate> candidates(const SweepResult& r, bool eye_model, ResampleSpace space) {
+  std::vector<Candidate> out;
+  bool base_taken = false;
+  for (const auto& k : r.knobs) {
+    if (!k.skipped.empty() || k.knob->eye_model != eye_model || k.resample_space != space) continue;
+    for (const auto& p : k.points) {
+      if (!p.ok()) continue;
+      if (p.is_default && !eye_model) {
+        if (base_taken) continue;
+        base_taken = true;
+      }
+      out.push_back({&k, &p});
+    }
+  }
+  return out;
+}
+
+// One front: what costs (x) and what errs (y) for each candidate.
+struct Front {
+  std::string name;
+  std::string cost_label, cost_unit, error_label;
+  std::vector<Candidate> points;
+  std::vector<double> cost, error;
+  std::vector<std::size_t> front;  // indices into points, ascending cost
+};
+
+Front make_front(std::string name, std::string cost_label, std::string cost_unit, std::string error_label,
+                 std::vector<Candidate> points, const std::function<double(const SweepPoint&)>& cost,
+                 const std::function<double(const SweepPoint&)>& error) {
+  Front f{std::move(name), std::move(cost_label), std::move(cost_unit), std::move(error_label), std::move(points),
+          {}, {}, {}};
+  for (const Candidate& c : f.points) {
+    f.cost.push_back(cost(*c.point));
+    f.error.push_back(error(*c.point));
+  }
+  f.front = pareto_front(f.cost, f.error);
+  return f;
+}
+
+double total_kib(const SweepPoint& p) { return static_cast<double>(p.on_chip_bits + p.off_chip_bits) / 8.0 / 1024.0; }
+
+// The three fronts of the run: decoder error against decode time and against memory, eye-model error against its
+// time.
+std::vector<Front> fronts(const SweepResult& r) {
+  const ResampleSpace space = r.options.pipeline.encoder.resample_space;
+  const auto decoder = candidates(r, false, space);
+  const auto mean_lsb = [](const SweepPoint& p) { return p.mean_lsb; };
+  return {make_front("decoder: error vs decode time", "decode time per view, ms (fastest of the repeats)",
+                     "ms/view", "mean |d| vs reference (output LSB)", decoder,
+                     [](const SweepPoint& p) { return p.min_seconds_per_frame * 1e3; }, mean_lsb),
+          make_front("decoder: error vs memory", "on + off chip memory (KiB)", "KiB",
+                     "mean |d| vs reference (output LSB)",
+                     decoder, total_kib, mean_lsb),
+          make_front("eye model: error vs run time", "eye-model time per frame, ms", "ms/frame",
+                     "visual difference vs the exact eye", candidates(r, true, space),
+                     [](const SweepPoint& p) { return p.eye_seconds_per_frame * 1e3; },
+                     [](const SweepPoint& p) { return p.visual_difference; })};
+}
+
+std::string candidate_name(const Candidate& c) {
+  return c.knob->knob->name + " " + std::to_string(c.point->value) + (c.point->is_default ? " (base)" : "");
+}
+
+std::string pareto_table_md(const SweepResult& r) {
+  std::ostringstream s;
+  s << "Points no other point of the same chart beats in both cost and error (cost ≤ and error ≤, one of them <); "
+       "decoder points of the run's resample space, the base once.\n\n"
+       "| front | point | mean LSB | max | identical | PSNR dB | visual diff. | cost |\n"
+       "|---|---|---|---|---|---|---|---|\n";
+  for (const Front& f : fronts(r)) {
+    for (std::size_t i : f.front) {
+      const SweepPoint& p = *f.points[i].point;
+      s << "| " << f.name << " | `" << candidate_name(f.points[i]) << "` | " << scientific(p.mean_lsb) << " | "
+        << general(p.max_lsb) << " | " << percent_text(p) << " | " << db_text(p.perceived_psnr_db) << " | "
+        << scientific(p.visual_difference) << " | " << fixed_text(f.cost[i], 2) << " " << f.cost_unit << " |\n";
+    }
+  }
+  return s.str();
+}
+
 
 }  // namespace
 
 std::string sweep_csv(const SweepResult& r) {
   const std::vector<std::string> columns = {
-      "knob", "value", "is_default", "status", "message", "identical_percent", "differing_codes", "codes", "max_lsb",
-      "mean_lsb", "rms_lsb", "linear_max", "linear_rms", "drive_max_lsb", "residual_saturated", "residual_rounded",
-      "seconds_per_frame", "min_seconds_per_frame", "reference_seconds_per_frame", "setup_seconds", "on_chip_bits",
-      "off_chip_bits", "delta_on_chip_bits", "delta_off_chip_bits", "residual_format", "meets_criterion"};
+      "knob", "resample_space", "value", "is_default", "status", "message", "identical_percent", "differing_codes",
+      "codes", "max_lsb", "mean_lsb", "rms_lsb", "linear_max", "linear_rms", "drive_max_lsb", "perceived_psnr_db",
+      "visual_difference", "residual_saturated", "residual_rounded", "seconds_per_frame", "min_seconds_per_frame",
+      "reference_seconds_per_frame", "setup_seconds", "eye_seconds_per_frame", "on_chip_bits", "off_chip_bits",
+      "delta_on_chip_bits", "delta_off_chip_bits", "residual_format", "meets_criterion"};
   std::ostringstream s;
   const auto row = [&s](const std::vector<std::string>& fields) {
     for (std::size_t i = 0; i < fields.size(); ++i) s << (i ? "," : "") << csv_field(fields[i]);
@@ -116,15 +209,16 @@ std::string sweep_csv(const SweepResult& r) {
   row(columns);
   for (const auto& k : r.knobs) {
     for (const auto& p : k.points) {
-      std::vector<std::string> f = {k.knob->name, std::to_string(p.value), p.is_default ? "1" : "0", p.status,
-                                    p.message};
+      std::vector<std::string> f = {k.knob->name, trm::to_string(k.resample_space), std::to_string(p.value),
+                                    p.is_default ? "1" : "0", p.status, p.message};
       if (p.ok()) {
         for (const std::string& v :
              {general(p.identical_percent), std::to_string(p.differing), std::to_string(p.codes), general(p.max_lsb),
               general(p.mean_lsb), general(p.rms_lsb), general(p.linear_max), general(p.linear_rms),
-              general(p.drive_max_lsb), std::to_string(p.residual_saturated), std::to_string(p.residual_rounded),
-              general(p.seconds_per_frame), general(p.min_seconds_per_frame), general(r.reference_seconds_per_frame),
-              general(p.setup_seconds), std::to_string(p.on_chip_bits), std::to_string(p.off_chip_bits),
+              general(p.drive_max_lsb), general(p.perceived_psnr_db), general(p.visual_difference),
+              std::to_string(p.residual_saturated), std::to_string(p.residual_rounded), general(p.seconds_per_frame),
+              general(p.min_seconds_per_frame), general(r.reference_seconds_per_frame), general(p.setup_seconds),
+              general(p.eye_seconds_per_frame), std::to_string(p.on_chip_bits), std::to_string(p.off_chip_bits),
               std::to_string(p.delta_on_chip_bits), std::to_string(p.delta_off_chip_bits), p.residual_format}) {
           f.push_back(v);
         }
@@ -141,19 +235,24 @@ namespace {
 
 std::string summary_table_md(const SweepResult& r) {
   std::ostringstream s;
-  s << "| knob | base | range | cheapest value meeting the criterion | identical | max | on-chip KiB | off-chip KiB "
-       "| Δ memory KiB | decode ms/frame | min ms |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  s << "| knob | base | range | cheapest value meeting the criterion | identical | max | mean | PSNR dB | visual diff. "
+       "| on-chip KiB | off-chip KiB | Δ memory KiB | decode ms/frame | min ms | eye ms/frame |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& k : r.knobs) {
     if (!k.skipped.empty()) continue;
-    const SweepPoint* c = k.cheapest_meeting();
-    s << "| `" << k.knob->name << "` | " << k.default_value << " | " << k.points.front().value << "–"
-      << k.points.back().value << " | ";
-    if (c) {
-      s << c->value << " | " << percent_text(*c) << " | " << general(c->max_lsb) << " | " << kib(c->on_chip_bits)
-        << " | " << kib(c->off_chip_bits) << " | " << signed_kib(c->delta_on_chip_bits + c->delta_off_chip_bits)
-        << " | " << ms(c->seconds_per_frame) << " | " << ms(c->min_seconds_per_frame) << " |\n";
+    const SweepPoint* c = k.knob->eye_model ? nullptr : k.cheapest_meeting();
+    s << "| `" << k.knob->name << "`" << (k.resample_space == ResampleSpace::Linear ? " (linear space)" : "") << " | "
+      << k.default_value << " | " << k.points.front().value << "–" << k.points.back().value << " | ";
+    if (k.knob->eye_model) {
+      s << "— (no code criterion: the base decoder, watched) | | | | | | | | | | | |\n";
+    } else if (c) {
+      s << c->value << " | " << percent_text(*c) << " | " << general(c->max_lsb) << " | " << scientific(c->mean_lsb)
+        << " | " << db_text(c->perceived_psnr_db) << " | " << scientific(c->visual_difference) << " | "
+        << kib(c->on_chip_bits) << " | " << kib(c->off_chip_bits) << " | "
+        << signed_kib(c->delta_on_chip_bits + c->delta_off_chip_bits) << " | " << ms(c->seconds_per_frame) << " | "
+        << ms(c->min_seconds_per_frame) << " | " << ms(c->eye_seconds_per_frame) << " |\n";
     } else {
-      s << "none | | | | | | | |\n";
+      s << "none | | | | | | | | | | | |\n";
     }
   }
   return s.str();
@@ -164,7 +263,7 @@ std::string summary_table_md(const SweepResult& r) {
 std::string sweep_markdown(const SweepResult& r) {
   std::ostringstream s;
   const auto& o = r.options;
-  s << "# Fixed-point decoder: error against run time and memory\n\n";
+  s << "# Every knob: error against run time and memory\n\n";
   s << "Regenerate with `" << o.command << "`.\n\n";
   s << "* sequence: " << header_line(r) << "; every knob swept alone, the others at the base configuration "
        "(the default formats, residual " << r.base.residual_format << ")\n";
@@ -184,6 +283,23 @@ std::string sweep_markdown(const SweepResult& r) {
     << " LSB; the cheapest value meeting it is the smallest value at and above which every "
        "accepted value meets it (every knob costs the same or more as it grows, and a value that passes below a "
        "failing one is not taken)\n\n";
+  s << "* perceived sequence (`sweep_perceived.hpp`): eye 0's drive codes through the panel's light over time and the "
+       "eye model (" << fixed_text(r.pixels_per_degree, 2) << " ppd, pursuing the target at "
+    << fixed_text(r.target_velocity_deg_s, 1) << " deg/s with the eye at " << fixed_text(r.eye_velocity_deg_s, 1)
+    << " deg/s, supplement Eq. 3): PSNR (sRGB) of the retinal image of every frame pair, and the visual difference "
+       "energy (supplement Eqs. 1–4) of the x–t image of row " << r.scan_line << " in the target's frame. Decoder "
+       "knobs: against the reference decoder's sequence seen by the same eye (" << kDefaultRetinaSubsteps
+    << " sub-steps); eye-model knobs: the base decoder watched with the knob's value, against the reference "
+       "decoder's sequence seen by the exact eye (" << kExactEyeSubsteps << " sub-steps); eye ms/frame: that eye "
+       "model's time per frame watched\n";
+  if (r.linear_base) {
+    s << "* linear-resample-space knobs: swept around a base of their own, the same options with "
+         "`--resample-space linear` (its own sequence and reference): base "
+      << percent_text(*r.linear_base) << " identical, max " << general(r.linear_base->max_lsb) << " LSB, "
+      << kib(r.linear_base->on_chip_bits) << " KiB on chip, " << kib(r.linear_base->off_chip_bits)
+      << " KiB off chip\n";
+  }
+  s << "\n## Pareto front\n\n![Pareto front](sweep_pareto.png)\n\n" << pareto_table_md(r) << "\n";
   s << "## Summary\n\n" << summary_table_md(r) << "\n";
   for (const auto& k : r.knobs) {
     s << "## `" << k.knob->name << "`\n\n" << k.knob->description << ". Cost: " << k.knob->cost << ".\n\n";
@@ -191,20 +307,24 @@ std::string sweep_markdown(const SweepResult& r) {
       s << "Skipped: " << k.skipped << ".\n\n";
       continue;
     }
+    if (k.resample_space == ResampleSpace::Linear && r.linear_base) {
+      s << "Swept around the linear-resample-space base (memory Δ against it).\n\n";
+    }
     s << "![" << k.knob->name << "](sweep_" << k.knob->name << ".png)\n\n";
-    s << "| value | identical | max | mean | RMS | linear max | linear RMS | drive v max | ms/frame | min ms "
-         "| on-chip KiB | off-chip KiB | Δ memory KiB | meets |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    s << "| value | identical | max | mean | RMS | linear max | linear RMS | drive v max | PSNR dB | visual diff. "
+         "| ms/frame | min ms | eye ms/frame | on-chip KiB | off-chip KiB | Δ memory KiB | meets |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& p : k.points) {
       s << "| " << value_text(p) << " | ";
       if (!p.ok()) {
-        s << p.status << ": " << md_cell(p.message) << " | | | | | | | | | | | | |\n";
+        s << p.status << ": " << md_cell(p.message) << " | | | | | | | | | | | | | | | |\n";
         continue;
       }
       s << percent_text(p) << " | " << general(p.max_lsb) << " | " << scientific(p.mean_lsb) << " | "
         << scientific(p.rms_lsb) << " | " << scientific(p.linear_max) << " | " << scientific(p.linear_rms) << " | "
-        << fixed_text(p.drive_max_lsb, 3) << " | " << ms(p.seconds_per_frame) << " | " << ms(p.min_seconds_per_frame)
-        << " | " << kib(p.on_chip_bits) << " | "
+        << fixed_text(p.drive_max_lsb, 3) << " | " << db_text(p.perceived_psnr_db) << " | "
+        << scientific(p.visual_difference) << " | " << ms(p.seconds_per_frame) << " | " << ms(p.min_seconds_per_frame)
+        << " | " << ms(p.eye_seconds_per_frame) << " | " << kib(p.on_chip_bits) << " | "
         << kib(p.off_chip_bits) << " | " << signed_kib(p.delta_on_chip_bits + p.delta_off_chip_bits) << " | "
         << (p.meets_criterion() ? "yes" : "no") << " |\n";
     }
@@ -255,11 +375,15 @@ Json sweep_json(const SweepResult& r) {
                    {"linear_max", p.linear_max},
                    {"linear_rms", p.linear_rms},
                    {"drive_max_lsb", p.drive_max_lsb}};
+    // +inf (identical) has no JSON number: null.
+    pj["perceived"] = {{"psnr_db", std::isinf(p.perceived_psnr_db) ? Json(nullptr) : Json(p.perceived_psnr_db)},
+                       {"visual_difference", p.visual_difference}};
     pj["residual_events"] = {{"saturated", p.residual_saturated}, {"rounded", p.residual_rounded}};
     pj["time"] = {{"seconds_per_frame", p.seconds_per_frame},
                   {"min_seconds_per_frame", p.min_seconds_per_frame},
                   {"repeat_seconds_per_frame", p.repeat_seconds_per_frame},
-                  {"setup_seconds", p.setup_seconds}};
+                  {"setup_seconds", p.setup_seconds},
+                  {"eye_seconds_per_frame", p.eye_seconds_per_frame}};
     pj["memory"] = {{"on_chip_bits", p.on_chip_bits},
                     {"off_chip_bits", p.off_chip_bits},
                     {"delta_on_chip_bits", p.delta_on_chip_bits},
@@ -268,7 +392,24 @@ Json sweep_json(const SweepResult& r) {
     pj["meets_criterion"] = p.meets_criterion();
     return pj;
   };
+  j["eye"] = {{"pixels_per_degree", r.pixels_per_degree},
+              {"target_velocity_deg_s", r.target_velocity_deg_s},
+              {"eye_velocity_deg_s", r.eye_velocity_deg_s},
+              {"scan_line", r.scan_line},
+              {"substeps", kDefaultRetinaSubsteps},
+              {"exact_substeps", kExactEyeSubsteps}};
   j["base"] = point_json(r.base);
+  if (r.linear_base) j["linear_base"] = point_json(*r.linear_base);
+  Json pareto = Json::array();
+  for (const Front& f : fronts(r)) {
+    Json points = Json::array();
+    for (std::size_t i : f.front) {
+      points.push_back({{"knob", f.points[i].knob->knob->name}, {"value", f.points[i].point->value},
+                        {"is_default", f.points[i].point->is_default}, {"cost", f.cost[i]}, {"error", f.error[i]}});
+    }
+    pareto.push_back({{"chart", f.name}, {"cost", f.cost_label}, {"error", f.error_label}, {"front", points}});
+  }
+  j["pareto"] = std::move(pareto);
   Json knobs = Json::array();
   for (const auto& k : r.knobs) {
     Json kj;
@@ -276,6 +417,8 @@ Json sweep_json(const SweepResult& r) {
     kj["description"] = k.knob->description;
     kj["cost"] = k.knob->cost;
     kj["base_value"] = k.default_value;
+    kj["resample_space"] = trm::to_string(k.resample_space);
+    kj["eye_model"] = k.knob->eye_model;
     if (!k.skipped.empty()) {
       kj["skipped"] = k.skipped;
     } else {
@@ -322,7 +465,8 @@ void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, c
     on_varies = on_varies || p->on_chip_bits != points.front()->on_chip_bits;
     off_varies = off_varies || p->off_chip_bits != points.front()->off_chip_bits;
   }
-  std::vector<double> x_value, x_memory, x_time, max_lsb, rms_lsb, mean_lsb;
+  const bool eye = k.knob->eye_model;
+  std::vector<double> x_value, x_memory, x_time, max_lsb, rms_lsb, mean_lsb, visual_difference;
   std::vector<std::string> labels;
   const SweepPoint* base = nullptr;
   for (const SweepPoint* p : points) {
@@ -332,7 +476,8 @@ void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, c
                               : off_varies            ? p->off_chip_bits
                                                       : p->on_chip_bits;
     x_memory.push_back(static_cast<double>(bits) / 8.0 / 1024.0);
-    x_time.push_back(p->min_seconds_per_frame * 1e3);
+    x_time.push_back((eye ? p->eye_seconds_per_frame : p->min_seconds_per_frame) * 1e3);
+    visual_difference.push_back(p->visual_difference);
     max_lsb.push_back(p->max_lsb);
     rms_lsb.push_back(p->rms_lsb);
     mean_lsb.push_back(p->mean_lsb);
@@ -341,22 +486,32 @@ void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, c
   const std::string memory_label = on_varies && off_varies ? "on + off chip memory (KiB)"
                                    : off_varies            ? "off-chip memory (KiB)"
                                                            : "on-chip memory (KiB)";
-  // The three errors against one x; zeros (exact agreement) sit hollow on the lower edge of the log error axis.
+  // The errors against one x (the code errors; an eye-model knob, which leaves the codes alone: the visual
+  // difference); zeros (exact agreement) sit hollow on the lower edge of the log error axis.
+  struct Error {
+    const char* label;
+    const std::vector<double>* y;
+    int colour;
+  };
+  const std::vector<Error> errors =
+      eye ? std::vector<Error>{{"visual difference", &visual_difference, 1}}
+          : std::vector<Error>{{"max |d|", &max_lsb, 3}, {"RMS |d|", &rms_lsb, 2}, {"mean |d|", &mean_lsb, 0}};
   const auto chart = [&](std::string title, const std::vector<double>& x, plot::Axis x_axis, plot::Style style,
                          bool value_labels) {
     plot::Chart c;
     c.title = std::move(title);
     c.x = std::move(x_axis);
-    c.y.label = "error vs reference (output LSB), 0 on the lower edge";
+    c.y.label = eye ? "visual difference vs the exact eye, 0 on the lower edge"
+                    : "error vs reference (output LSB), 0 on the lower edge";
     c.y.scale = plot::Scale::Log;
     c.y.nonpositive_on_edge = true;
-    c.series = {{.label = "max |d|", .x = x, .y = max_lsb, .style = style, .colour = 3},
-                {.label = "RMS |d|", .x = x, .y = rms_lsb, .style = style, .colour = 2},
-                {.label = "mean |d|", .x = x, .y = mean_lsb, .style = style, .colour = 0}};
+    for (const Error& e : errors) {
+      c.series.push_back({.label = e.label, .x = x, .y = *e.y, .style = style, .colour = e.colour});
+    }
     if (value_labels) c.series.front().point_labels = labels;
     if (base) {
       const auto i = static_cast<std::size_t>(std::find(points.begin(), points.end(), base) - points.begin());
-      for (const std::vector<double>* y : {&max_lsb, &rms_lsb, &mean_lsb}) c.rings.push_back({x[i], (*y)[i]});
+      for (const Error& e : errors) c.rings.push_back({x[i], (*e.y)[i]});
       c.rings_label = "base value";
     }
     return c;
@@ -365,8 +520,79 @@ void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, c
       chart("error vs knob value", x_value, spread_axis(x_value, k.knob->name), plot::Style::LineAndPoints, false),
       chart(on_varies || off_varies ? "error vs memory" : "error vs memory (unchanged by this knob)", x_memory,
             spread_axis(x_memory, memory_label), plot::Style::LineAndPoints, true),
-      chart("error vs decode time", x_time, spread_axis(x_time, "decode time per view, ms (fastest of the repeats)"),
-            plot::Style::Points, true)};
+      eye ? chart("error vs eye-model time", x_time, spread_axis(x_time, "eye-model time per frame, ms (fastest of "
+                                                                       "the repeats)"),
+                  plot::Style::Points, true)
+          : chart("error vs decode time", x_time,
+                  spread_axis(x_time, "decode time per view, ms (fastest of the repeats)"), plot::Style::Points, true)};
+  plot::write_png(path, figure);
+}
+
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& error) {
+  if (cost.size() != error.size()) throw std::invalid_argument("pareto_front: cost and error differ in length");
+  std::vector<std::size_t> order(cost.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  // By cost, then error: a point is on the front when its error is below every cheaper (or equally cheap, less
+  // erring) point's. Equal points are all on it.
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return cost[a] != cost[b] ? cost[a] < cost[b] : error[a] < error[b];
+  });
+  std::vector<std::size_t> front;
+  for (std::size_t i : order) {
+    if (front.empty()) {
+      front.push_back(i);
+      continue;
+    }
+    const std::size_t last = front.back();
+    const bool same = cost[i] == cost[last] && error[i] == error[last];
+    if (same || error[i] < error[last]) front.push_back(i);
+  }
+  return front;
+}
+
+void write_pareto_plot(const std::filesystem::path& path, const SweepResult& r) {
+  plot::Figure figure;
+  figure.width = 1800;
+  figure.height = 560;
+  figure.title = "Pareto fronts: error against run time and memory, every knob swept alone";
+  figure.subtitle = header_line(r);
+  figure.subtitle.append("; memory at ").append(std::to_string(r.options.hw_size.width)).append("x").append(
+      std::to_string(r.options.hw_size.height));
+  for (const Front& f : fronts(r)) {
+    plot::Chart chart;
+    chart.title = f.name;
+    chart.y.label = f.error_label + ", 0 on the lower edge";
+    chart.y.scale = plot::Scale::Log;
+    chart.y.nonpositive_on_edge = true;
+    if (f.points.empty()) {
+      chart.note = "no knob of this kind was swept";
+      figure.charts.push_back(std::move(chart));
+      continue;
+    }
+    chart.x = spread_axis(f.cost, f.cost_label);
+    // Room on the right for the front's labels.
+    const auto [lo, hi] = std::minmax_element(f.cost.begin(), f.cost.end());
+    const double span = *hi - *lo > 0 ? *hi - *lo : std::max(std::abs(*hi), 1.0);
+    chart.x.max = chart.x.scale == plot::Scale::Log ? *hi * 3.0 : *hi + 0.25 * span;
+    std::vector<double> front_x, front_y;
+    std::vector<std::string> labels;
+    for (std::size_t i : f.front) {
+      front_x.push_back(f.cost[i]);
+      front_y.push_back(f.error[i]);
+      labels.push_back(candidate_name(f.points[i]));
+    }
+    chart.series = {{.label = "every point", .x = f.cost, .y = f.error, .style = plot::Style::Points, .colour = 7},
+                    {.label = "Pareto front", .x = front_x, .y = front_y, .style = plot::Style::LineAndPoints,
+                     .colour = 1, .point_labels = labels}};
+    for (std::size_t i = 0; i < f.points.size(); ++i) {
+      if (f.points[i].point->is_default) {
+        chart.rings.push_back({f.cost[i], f.error[i]});
+        break;
+      }
+    }
+    chart.rings_label = "default";
+    figure.charts.push_back(std::move(chart));
+  }
   plot::write_png(path, figure);
 }
 
@@ -376,6 +602,9 @@ std::string sweep_summary(const SweepResult& r) {
     << percent_text(r.base) << " identical, max " << general(r.base.max_lsb) << " LSB, "
     << ms(r.base.seconds_per_frame) << " ms/view, " << kib(r.base.on_chip_bits) << " KiB on / "
     << kib(r.base.off_chip_bits) << " KiB off chip at " << r.options.hw_size.width << "x" << r.options.hw_size.height
+    << "; perceived PSNR " << db_text(r.base.perceived_psnr_db)
+    << (std::isinf(r.base.perceived_psnr_db) ? "" : " dB") << ", visual difference "
+    << scientific(r.base.visual_difference)
     << "\n  cheapest value with >= " << kReferenceAgreementCriterion.min_identical_percent()
     << " % identical and max <= " << kReferenceAgreementCriterion.max_lsb << " LSB:\n";
   s << "  " << std::left << std::setw(30) << "knob" << std::right << std::setw(6) << "base" << std::setw(10)
@@ -386,6 +615,14 @@ std::string sweep_summary(const SweepResult& r) {
     s << "  " << std::left << std::setw(30) << k.knob->name << std::right << std::setw(6) << k.default_value;
     if (!k.skipped.empty()) {
       s << "   skipped: " << k.skipped << "\n";
+      continue;
+    }
+    if (k.knob->eye_model) {
+      s << "   eye model (base decoder): visual difference vs the exact eye";
+      for (const SweepPoint& p : k.points) {
+        if (p.ok()) s << " " << p.value << ":" << scientific(p.visual_difference);
+      }
+      s << "\n";
       continue;
     }
     const SweepPoint* c = k.cheapest_meeting();

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace trm::cli {
 
@@ -20,8 +21,16 @@ std::string sweep_markdown(const SweepResult& result);
 Json sweep_json(const SweepResult& result);
 // Its "parameters" block: the sequence and configuration every point was decoded with.
 Json sweep_parameters_json(const SweepResult& result);
-// sweep_<knob>.png: error against knob value, against memory and against decode time.
+// sweep_<knob>.png: error against knob value, against memory and against decode time (eye-model knobs: the visual
+// difference against the eye-model time).
 void write_sweep_plot(const std::filesystem::path& path, const SweepResult& result, const SweepKnobResult& knob);
+// sweep_pareto.png: the decoder knobs' mean code error against decode time and against memory, the eye-model knobs'
+// visual difference against eye-model time; each chart marks its Pareto front and the default point.
+void write_pareto_plot(const std::filesystem::path& path, const SweepResult& result);
+// The indices of the points on the Pareto front of (cost, error), both minimised: those no other point beats with
+// cost <= and error <= and one of them <. Ascending cost; equal points are all on it. Throws std::invalid_argument
+// when the two differ in length.
+std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std::vector<double>& error);
 // The short table printed to stdout: per knob, the base point and the cheapest point meeting the criterion.
 std::string sweep_summary(const SweepResult& result);
 

@@ -34,6 +34,7 @@ std::string sweep_command_text(const std::vector<GivenOption>& options);
 struct SweepPart {
   std::filesystem::path dir;
   bool has_base = false;             // the shard that owns the base point (point 0)
+  bool has_linear_base = false;      // the shard that owns the linear base (point 1, when the sweep has one)
   std::string version;               // of the trm that wrote it
   std::vector<GivenOption> options;  // the sweep's, without --shard and --out
   SweepResult result;                // unfinished (see run_sweep): this shard's points only
