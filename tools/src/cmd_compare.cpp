@@ -7,6 +7,7 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace trm::cli {
 
@@ -34,12 +35,13 @@ void register_compare(CLI::App& app, Action& action) {
     action = [options, out] {
       options->validate();
       OutputDir dir(*out);
-      const std::int64_t frames = options->pipeline.frames > 0 ? options->pipeline.frames : options->pipeline.default_frames;
-      Progress progress(static_cast<std::int64_t>(options->chosen_methods().size()) * frames *
-                        (options->pipeline.encoder.stereo ? 2 : 1));
-      const CompareResult result =
-          run_compare(*options, [&](std::int64_t done, std::int64_t) { progress.update(done); });
-      progress.finish();
+      // The total is run_compare's: the chosen methods and, when `full` is not among them, the full-rate reference.
+      std::optional<Progress> progress;
+      const CompareResult result = run_compare(*options, [&](std::int64_t done, std::int64_t total) {
+        if (!progress) progress.emplace(total);
+        progress->update(done);
+      });
+      if (progress) progress->finish();
       dir.write_text("compare.md", compare_markdown(result));
       dir.write_text("compare.csv", compare_csv(result));
       dir.write_text("report.json", compare_json(result).dump(2) + "\n");
