@@ -132,6 +132,15 @@ inline void expect_identical_outputs(const DecodedFrame& a, const FixedStageCoun
   EXPECT_EQ(counts_a.lcd_unreachable, counts_b.lcd_unreachable) << where;
 }
 
+// The DESIGN §7 skip counters of two decodes of one view (skipping decoders of two schedules or thread counts).
+inline void expect_skip_counts_equal(const FixedStageCounts& a, const FixedStageCounts& b, const std::string& where) {
+  EXPECT_EQ(a.motion_test_lines_skipped, b.motion_test_lines_skipped) << where;
+  EXPECT_EQ(a.residual_read_lines_skipped, b.residual_read_lines_skipped) << where;
+  EXPECT_EQ(a.residual_write_lines_skipped, b.residual_write_lines_skipped) << where;
+  EXPECT_EQ(a.grey_lines, b.grey_lines) << where;
+  EXPECT_EQ(a.grey_reduced_rows, b.grey_reduced_rows) << where;
+}
+
 // Streams the frames through both schedules and requires identical bits in every output and statistic.
 inline void expect_schedules_identical(const std::vector<LinkFrame>& frames, const FixedDecoderConfig& config,
                                        const std::string& what, const ArrivalPlan& plan = whole) {

@@ -14,6 +14,7 @@ namespace {
 
 using test::encode_sequence;
 using test::expect_identical_outputs;
+using test::expect_skip_counts_equal;
 using test::fixed_config;
 using test::link_config;
 using test::scene_images;
@@ -21,14 +22,6 @@ using test::scene_images;
 FixedDecoderConfig with_skip(FixedDecoderConfig config, bool skip) {
   config.skip_unneeded = skip;
   return config;
-}
-
-void expect_skip_counts_equal(const FixedStageCounts& a, const FixedStageCounts& b, const std::string& where) {
-  EXPECT_EQ(a.motion_test_lines_skipped, b.motion_test_lines_skipped) << where;
-  EXPECT_EQ(a.residual_read_lines_skipped, b.residual_read_lines_skipped) << where;
-  EXPECT_EQ(a.residual_write_lines_skipped, b.residual_write_lines_skipped) << where;
-  EXPECT_EQ(a.grey_lines, b.grey_lines) << where;
-  EXPECT_EQ(a.grey_reduced_rows, b.grey_reduced_rows) << where;
 }
 
 // Per view: the skip counters of the skipping streaming decoder (the frame schedule's are asserted equal).

@@ -14,6 +14,7 @@ namespace {
 
 using test::encode_sequence;
 using test::expect_identical_outputs;
+using test::expect_skip_counts_equal;
 using test::fixed_config;
 using test::identical;
 using test::link_config;
@@ -22,14 +23,6 @@ using test::scene_images;
 FixedDecoderConfig with_threads(FixedDecoderConfig config, int threads) {
   config.threads = threads;
   return config;
-}
-
-void expect_skip_counts_equal(const FixedStageCounts& a, const FixedStageCounts& b, const std::string& where) {
-  EXPECT_EQ(a.motion_test_lines_skipped, b.motion_test_lines_skipped) << where;
-  EXPECT_EQ(a.residual_read_lines_skipped, b.residual_read_lines_skipped) << where;
-  EXPECT_EQ(a.residual_write_lines_skipped, b.residual_write_lines_skipped) << where;
-  EXPECT_EQ(a.grey_lines, b.grey_lines) << where;
-  EXPECT_EQ(a.grey_reduced_rows, b.grey_reduced_rows) << where;
 }
 
 // Every view through one pipeline and through 2 and 3 bands: identical outputs, statistics and counters.

@@ -35,6 +35,7 @@ void register_compare(CLI::App& app, Action& action) {
     action = [options, out] {
       options->validate();
       OutputDir dir(*out);
+      const std::int64_t frames = options->pipeline.frames > 0 ? options->pipeline.frames : options->pipeline.default_frames;
       // The total is run_compare's: the chosen methods and, when `full` is not among them, the full-rate reference.
       std::optional<Progress> progress;
       const CompareResult result = run_compare(*options, [&](std::int64_t done, std::int64_t total) {
