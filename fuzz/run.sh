@@ -38,7 +38,7 @@ jobs=${TRM_FUZZ_JOBS:-2}
 mkdir -p "$build/obj" "$build/logs"
 
 includes=(-I"$root/link/include" -I"$root/link/src" -I"$root/encoder/include" -I"$root/encoder/src"
-          -I"$root/hw_models/include" -I"$root/fixed_point/include" -I"$root/tools/src" -I"$root/tools/rig/include" -isystem /usr/include/opencv4)
+          -I"$root/hw_models/include" -I"$root/fixed_point/include" -I"$root/tools/src" -I"$root/tools/rig/include" -isystem /usr/include/opencv4 -isystem /usr/include/eigen3)
 common=(-std=c++20 -g -O1 -fno-omit-frame-pointer "${includes[@]}")
 sanitize=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
 libs=(-lcharls -lz -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lopencv_core)
@@ -48,7 +48,7 @@ header_dirs=("$root/link/include" "$root/link/src" "$root/encoder/include" "$roo
 # The library sources the targets reach, instrumented for coverage (fuzzer-no-link) and the sanitizers,
 # compiled TRM_FUZZ_JOBS at a time and rebuilt when a source or a project header is newer.
 sources=("$root"/link/src/*.cpp "$root"/encoder/src/{frame,transfer,sources}.cpp "$root"/encoder/src/scenes/scene_support.cpp
-         "$root"/hw_models/src/panel.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp)
+         "$root"/hw_models/src/panel.cpp "$root"/hw_models/src/lc_second_order.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp)
 compile() {  # SOURCE OBJECT HEADER_DIR... -- FLAGS...
   local src=$1 obj=$2 dirs=()
   shift 2
