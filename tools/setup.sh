@@ -21,6 +21,7 @@ packages=(
   libcharls-dev            # JPEG-LS lossless link codec
   libplplot-dev            # the plots (PLplot)
   libeigen3-dev            # Levenberg-Marquardt least squares of `trm calibrate` (Eq. 7 fit); the matrix exponential of the second-order LC model; head-pose quaternions and slerp
+  libhwy-dev               # Google Highway: the streaming decoder's line kernels in SIMD, dispatched at run time to the CPU's widest instruction set
   plplot-driver-cairo      # PLplot's pngcairo driver, a package of its own: PNG without a display
   fonts-dejavu-core        # the plots' text on a machine with no desktop fonts
   umockdev libumockdev-dev # emulated USB/HID devices for rig tests

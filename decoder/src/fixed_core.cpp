@@ -117,15 +117,70 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
   return out.full ? s.shortfall : 0;
 }
 
+const std::uint32_t* ColumnBlendCache::row(const std::uint16_t* codes, int index, const ColumnBlendPlan& plan) {
+  for (const Entry& e : entries_) {
+    if (e.codes == codes && e.index == index) return e.blended.data();
+  }
+  Entry& e = entries_[next_];
+  next_ ^= 1;
+  e.codes = codes;
+  e.index = index;
+  e.blended.resize(plan.upper.size());
+  lines::blend_columns(codes, plan, plan.upper.size(), e.blended.data());
+  return e.blended.data();
+}
+
+void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
+                                Raw* out, bool grey, ColumnBlendCache& cache) const {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const std::optional<EotfPlan>& eotf = kernels_.line_plans().eotf;
+  if (!eotf) {
+    kernels_.upsample_line(row0, row1, g, row.upper, out, grey);
+    return;
+  }
+  // Every channel, grey or not: the grey line's copies are the same bits, and the vector lanes cost no more.
+  const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
+  const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
+  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper), *eotf, out);
+}
+
 void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,
                                  const std::uint16_t* codes_row, const std::uint16_t* low0, const std::uint16_t* low1,
                                  std::int32_t* residual_row, bool lost, bool grey, LineScratch& scratch) const {
   const int samples = 3 * g.full.width;
-  scratch.first.resize(static_cast<std::size_t>(samples));
-  kernels_.upsample_line(low0, low1, g, g.bilinear_rows[static_cast<std::size_t>(y)].upper, scratch.first.data(),
-                         grey);  // L_t
-  for (int x = 0; x < g.full.width; ++x) {
-    full_pixel(out, eye, y, x, codes_row, scratch.first.data() + 3 * x, residual_row, lost, grey);
+  const auto n = static_cast<std::size_t>(samples);
+  scratch.first.resize(n);
+  upsample(low0, low1, g, y, scratch.first.data(), grey, scratch.first_rows);  // L_t
+  if (lost || !line_kernels(out)) {
+    for (int x = 0; x < g.full.width; ++x) {
+      full_pixel(out, eye, y, x, codes_row, scratch.first.data() + 3 * x, residual_row, lost, grey);
+    }
+    return;
+  }
+  // The line kernels: Eq. 2 and the split over the line, the drive codes of the shown values, then the residual
+  // store, whose rounding and saturation act only where rho is not zero.
+  scratch.shown.resize(n);
+  scratch.rho.resize(n);
+  const FixedLinePlans& plans = kernels_.line_plans();
+  const std::uint64_t clipped = lines::compensate(codes_row, scratch.first.data(), n, plans.code_rom.data(), plans.one,
+                                                  scratch.shown.data(), scratch.rho.data());
+  FrameTally& t = out.tally;
+  t.clipped += clipped;
+  t.counts.beta_clipped += clipped;
+  lines::drive_codes(scratch.shown.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+  const Raw* rho = scratch.rho.data();
+  for (std::size_t s = 0; s < n; ++s) {
+    if (rho[s] == 0) {
+      residual_row[s] = 0;
+      continue;
+    }
+    const StoredResidual stored = kernels_.store_residual(rho[s]);
+    residual_row[s] = static_cast<std::int32_t>(stored.value);
+    t.counts.residual_saturated += stored.saturated ? 1 : 0;
+    t.counts.residual_rounded += stored.rounded ? 1 : 0;
+    const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
+    t.residual_abs_sum += magnitude;
+    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
   }
 }
 
@@ -134,19 +189,26 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
                                     const std::uint16_t* prev1, const std::int32_t* residual_row,
                                     const ReducedLineGate* gate, bool grey, LineScratch& scratch) const {
   const int samples = 3 * g.full.width;
-  const Raw row_upper = g.bilinear_rows[static_cast<std::size_t>(y)].upper;
-  scratch.first.resize(static_cast<std::size_t>(samples));
-  kernels_.upsample_line(in0, in1, g, row_upper, scratch.first.data(), grey);  // Eq. 1: alpha
+  const auto n = static_cast<std::size_t>(samples);
+  scratch.first.resize(n);
+  upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);  // Eq. 1: alpha
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
   const bool previous_needed = (residual_row != nullptr || residual_zero) && !motion_static;
   if (previous_needed) {  // L_{t-1} from the stored d_{t-1} rows
-    scratch.second.resize(static_cast<std::size_t>(samples));
-    kernels_.upsample_line(prev0, prev1, g, row_upper, scratch.second.data(), grey);
+    scratch.second.resize(n);
+    upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
   }
+  // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line.
+  const bool whole_line = line_kernels(out);
+  if (whole_line) scratch.shown.resize(n);
+  Raw* shown = whole_line ? scratch.shown.data() : nullptr;
   for (int x = 0; x < g.full.width; ++x) {
     reduced_pixel(out, eye, y, x, scratch.first.data() + 3 * x,
-                  previous_needed ? scratch.second.data() + 3 * x : nullptr, residual_row, gate, grey);
+                  previous_needed ? scratch.second.data() + 3 * x : nullptr, residual_row, gate, grey, shown);
+  }
+  if (whole_line) {
+    lines::drive_codes(shown, n, *kernels_.line_plans().drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
   }
 }
 
@@ -205,7 +267,14 @@ void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, con
 
 void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, int y, int x, const Raw* alpha,
                                      const Raw* previous_low, const std::int32_t* residual_row,
-                                     const ReducedLineGate* gate, bool grey) const {
+                                     const ReducedLineGate* gate, bool grey, Raw* shown_line) const {
+  const auto show = [&](int ch, Raw value) {
+    if (shown_line != nullptr) {
+      shown_line[3 * x + ch] = value;
+    } else {
+      emit(out, eye, y, x, ch, value);
+    }
+  };
   for (int ch = 0; ch < 3; ++ch) tap(out, Stage::Alpha, y, x, ch, alpha[ch]);
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
@@ -214,7 +283,7 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, int y, int
     for (int ch = 0; ch < 3; ++ch) {
       const Raw shown = std::clamp(alpha[ch], Raw{0}, kernels_.one());
       tap(out, Stage::AlphaPrime, y, x, ch, shown);
-      emit(out, eye, y, x, ch, shown);
+      show(ch, shown);
     }
     return;
   }
@@ -247,7 +316,7 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, int y, int
     t.residual_abs_sum += magnitude;
     t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
     tap(out, Stage::AlphaPrime, y, x, ch, s.alpha_prime);
-    emit(out, eye, y, x, ch, s.alpha_prime);
+    show(ch, s.alpha_prime);
   }
 }
 

@@ -68,11 +68,42 @@ struct ReducedLineGate {
   bool residual_zero = false;  // rho all zero on the line: no residual read, no add
 };
 
-// The U results of one output line (L_t; alpha and L_{t-1}), reused from line to line: one per pipeline (each band
-// of a view has its own).
+// U's column blends of the last two reduced rows read from one source (a row of d_t, i or d_{t-1} held by the
+// schedule's line buffers or frame stores), so that each row is blended along x once although two or more output
+// lines read it. A row is known by its buffer address and its row index, which within one view (and band) name one
+// content: the schedules write a row before they read it and never rewrite it.
+class ColumnBlendCache {
+ public:
+  ColumnBlendCache() = default;
+  // A copy (a band of a view, with buffers of its own) starts empty: its rows live at other addresses.
+  ColumnBlendCache(const ColumnBlendCache&) {}
+  ColumnBlendCache& operator=(const ColumnBlendCache&) {
+    *this = ColumnBlendCache();
+    return *this;
+  }
+  ColumnBlendCache(ColumnBlendCache&&) = default;
+  ColumnBlendCache& operator=(ColumnBlendCache&&) = default;
+  const std::uint32_t* row(const std::uint16_t* codes, int index, const ColumnBlendPlan& plan);
+
+ private:
+  struct Entry {
+    const std::uint16_t* codes = nullptr;
+    int index = -1;
+    std::vector<std::uint32_t> blended;
+  };
+  Entry entries_[2];
+  int next_ = 0;
+};
+
+// The U results of one output line (L_t; alpha and L_{t-1}) and the line kernels' buffers, reused from line to line:
+// one per pipeline (each band of a view has its own, so no two threads share one).
 struct LineScratch {
   std::vector<Raw> first;
   std::vector<Raw> second;
+  ColumnBlendCache first_rows;   // U's source rows of `first` (d_t for a full frame, i for a reduced one)
+  ColumnBlendCache second_rows;  // and of `second` (d_{t-1})
+  std::vector<Raw> shown;        // the line's emitted linear values
+  std::vector<Raw> rho;          // a full frame's beta - shown
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.
@@ -204,10 +235,21 @@ class FixedDecoderCore {
  private:
   // The per-pixel steps of full_line and reduced_line, from the line's U results (low: L_t of the pixel; alpha and
   // previous_low: alpha and L_{t-1}, previous_low null where the motion test does not read it).
+  // U and lin() of output line y from d rows row0 (g.bilinear_rows[y].i0) and row1 (.i1): through the line kernels
+  // and the cache where the plans allow, else FixedKernels::upsample_line.
+  void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, Raw* out, bool grey,
+                ColumnBlendCache& cache) const;
+  // The line kernels take a whole line: OLED drive codes without report planes or taps (emit's other work).
+  bool line_kernels(const FrameOutput& out) const {
+    return kernels_.line_plans().eotf && kernels_.line_plans().drive && !config().report_planes &&
+           out.taps == nullptr;
+  }
   void full_pixel(FrameOutput& out, EyeState& eye, int y, int x, const std::uint16_t* codes_row, const Raw* low,
                   std::int32_t* residual_row, bool lost, bool grey) const;
+  // shown: null emits each sample; else the samples' wanted values are stored at shown[3x + ch] for the line's
+  // drive codes.
   void reduced_pixel(FrameOutput& out, EyeState& eye, int y, int x, const Raw* alpha, const Raw* previous_low,
-                     const std::int32_t* residual_row, const ReducedLineGate* gate, bool grey) const;
+                     const std::int32_t* residual_row, const ReducedLineGate* gate, bool grey, Raw* shown) const;
 
   FixedKernels kernels_;
   std::map<int, EyeState> eyes_;

@@ -4,6 +4,7 @@
 // Raw values are integers; each function states its Q formats. F = linear_frac_bits throughout.
 #pragma once
 
+#include "fixed_lines.hpp"
 #include "fixed_tables.hpp"
 
 #include "trm/fixed_decoder.hpp"
@@ -46,6 +47,7 @@ struct Geometry {
   std::vector<PolyphaseTaps> gauss_rows;  // reduced.height entries
   std::vector<BilinearWeights> bilinear_cols;  // full.width entries
   std::vector<BilinearWeights> bilinear_rows;  // full.height entries
+  ColumnBlendPlan column_blend;                // U's column taps per output sample, for the line kernels
 };
 
 // Result of Eq. 2 and the split for one channel sample of a full frame.
@@ -217,6 +219,13 @@ class FixedKernels {
     return (*emission_)(code, previous_code, ch);
   }
 
+  // The ROMs themselves, for the line kernels' plans (fixed_lines.hpp).
+  const std::vector<Raw>& code_rom() const { return code_rom_; }
+  const fx::InterpolatedLut* eotf_lut() const { return eotf_.get(); }
+  const ThresholdIndex& drive_index(int ch) const { return drive_index_[static_cast<std::size_t>(ch)]; }
+  // The line kernels' tables for this configuration (empty where its formats do not fit their lanes).
+  const FixedLinePlans& line_plans() const { return line_plans_; }
+
   // Every ROM of this configuration (name, words, word bits, copies).
   std::vector<FixedRomReport> roms() const;
   // The operator table of the per-pixel stages at the geometry's sizes (see the table in fixed_resources.cpp).
@@ -250,6 +259,7 @@ class FixedKernels {
   double drive_lsb_ = 0.0;
   double residual_lsb_ = 0.0;
   std::map<std::pair<int, int>, Geometry> geometries_;
+  FixedLinePlans line_plans_;
   // LCD: merge coefficients in sQ.kLcdCoefficientBits, x^(1/gamma) LUT for m, and M(0, vp)^gamma, M(1, vp)^gamma
   // ROMs (uQ/sQ.F) for the shortfall at the two clamped drives.
   bool lcd_ = false;

@@ -128,6 +128,7 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
         }
       }
     }
+    line_plans_ = FixedLinePlans::build(*this);
     return;
   }
   // OLED drive: thresholds T_k = ((k - 1/2) / (2^o - 1))^gamma, the light of the drive half a code below k, rounded
@@ -152,6 +153,7 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
     drive_luts_[static_cast<std::size_t>(ch)] =
         std::make_unique<fx::InterpolatedLut>(fx::make_inverse_gamma_lut(gamma, drive_shape));
   }
+  line_plans_ = FixedLinePlans::build(*this);
 }
 
 const Geometry& FixedKernels::geometry(cv::Size full) {
@@ -189,6 +191,7 @@ const Geometry& FixedKernels::geometry(cv::Size full) {
   g.gauss_rows = gauss_axis(full.height, g.reduced.height);
   g.bilinear_cols = bilinear_axis(full.width, g.reduced.width);
   g.bilinear_rows = bilinear_axis(full.height, g.reduced.height);
+  if (line_plans_.eotf) g.column_blend = column_blend_plan(g, line_plans_.eotf->unit);
   return geometries_.emplace(key, std::move(g)).first->second;
 }
 

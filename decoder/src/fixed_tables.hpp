@@ -51,6 +51,11 @@ class ThresholdIndex {
     for (int i = 0; i < steps_; ++i) k += x >= padded_[k + 1] ? 1 : 0;
     return static_cast<std::uint16_t>(k);
   }
+  // The index itself, for the vectorised search (fixed_lines.hpp); steps() == 0: not usable.
+  int steps() const { return steps_; }
+  int value_bits() const { return value_bits_; }
+  const std::vector<std::uint16_t>& base() const { return base_; }
+  const std::vector<std::int64_t>& padded() const { return padded_; }
 
  private:
   static std::size_t bucket_of(std::uint64_t u) {

@@ -56,7 +56,13 @@ struct BenchOptions {
   std::vector<std::string> sizes;   // WxH or WxHs (stereo); empty: the headset sizes
   std::vector<std::string> panels;  // empty: vive and lcd
   int threads = 0;                  // the streaming decoder's threads; 0: the machine's hardware threads
+  std::vector<std::string> only;    // contenders to time besides the OpenCV yardstick; empty: all
 };
+
+// Every contender's name, in the order they are listed; the OpenCV decoder is the yardstick of every ratio and is
+// always timed.
+const std::vector<std::string> kContenders = {"fixed", "fixed-1t", "fixed+planes", "fixed-frame", "reference",
+                                              "opencv-float32"};
 
 BenchSize parse_bench_size(const std::string& text) {
   const bool stereo = !text.empty() && text.back() == 's';
@@ -106,6 +112,14 @@ double peak_mib() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
+// CPU time of the whole process (user + system, every thread).
+double process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
@@ -117,7 +131,9 @@ struct Contender {
   std::string name;
   int threads = 1;
   std::function<std::function<void(const LinkFrame&)>()> make;
-  std::vector<double> seconds;  // per repeat
+  std::vector<double> seconds;      // per repeat
+  std::vector<double> cpu_seconds;  // per repeat, every thread of the process (steadier than wall time on a loaded
+                                    // machine; the machine's other processes are not in it)
   double peak_rss_mib = 0.0;
   double rss_before_mib = 0.0;
 };
@@ -170,7 +186,11 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   codes_only.report_planes = false;
   FixedDecoderConfig banded = codes_only;
   banded.threads = options.threads;
-  const auto add = [&contenders, &size](std::string name, const char* impl, FixedDecoderConfig c) {
+  const auto wanted = [&options](const std::string& name) {
+    return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+  };
+  const auto add = [&contenders, &size, &wanted](std::string name, const char* impl, FixedDecoderConfig c) {
+    if (!wanted(name)) return;
     const int threads =
         std::string(impl) == "fixed" ? FixedStreamingDecoder(c).threads_for(cv::Size(size.width, size.height)) : 1;
     contenders.push_back({std::move(name), threads,
@@ -178,7 +198,7 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                             std::shared_ptr<HeadsetDecoder> d = make_decoder(impl, c);
                             return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
                           },
-                          {}, 0.0, 0.0});
+                          {}, {}, 0.0, 0.0});
   };
   if (banded.threads > 1) add("fixed", "fixed", banded);
   add(banded.threads > 1 ? "fixed-1t" : "fixed", "fixed", codes_only);
@@ -190,7 +210,7 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                           auto d = std::make_shared<bench::OpencvTrmDecoder>(config.decoder);
                           return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
                         },
-                        {}, 0.0, 0.0});
+                        {}, {}, 0.0, 0.0});
   const int repeats = options.repeats;
   for (int repeat = 0; repeat < repeats; ++repeat) {
     // Interleaved, the order rotating per repeat, so that no contender always runs first (cold) or last.
@@ -202,9 +222,11 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
         c.rss_before_mib = status_kib("VmRSS") / 1024.0;
         reset_peak();
       }
+      const double cpu0 = process_cpu_seconds();
       const auto t0 = std::chrono::steady_clock::now();
       for (const LinkFrame& view : views) decode(view);
       c.seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      c.cpu_seconds.push_back(process_cpu_seconds() - cpu0);
       if (measure_memory) c.peak_rss_mib = peak_mib();
     }
   }
@@ -221,7 +243,7 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
        << static_cast<int>(link_frames) << " frames, median of " << repeats << "\n";
   text << "  " << std::left << std::setw(16) << "decoder" << std::right << std::setw(9) << "Mpix/s" << std::setw(11)
        << "ms/frame" << std::setw(10) << "vs cv" << std::setw(9) << "RT@90" << std::setw(9) << "RT@120"
-       << std::setw(9) << "RT@144" << std::setw(9) << "threads" << std::setw(11) << "peak MiB" << "\n";
+       << std::setw(9) << "RT@144" << std::setw(9) << "threads" << std::setw(11) << "peak MiB" << std::setw(13) << "cpu ms/frame" << "\n";
   Json decoders = Json::array();
   for (const Contender& c : contenders) {
     const double seconds = median(c.seconds);
@@ -233,6 +255,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                         {"threads", c.threads},
                         {"mpix_per_s", mpix_per_s},
                         {"ms_per_frame", ms_per_frame},
+                        {"cpu_ms_per_frame", 1e3 * median(c.cpu_seconds) / link_frames},
+                        {"repeat_cpu_seconds", c.cpu_seconds},
                         {"ratio_to_opencv", opencv_seconds / seconds},
                         {"realtime_factor", realtime},
                         {"peak_rss_mib", c.peak_rss_mib},
@@ -242,7 +266,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
          << std::setw(9) << mpix_per_s << std::setw(11) << ms_per_frame << std::setw(10) << opencv_seconds / seconds
          << std::setprecision(3) << std::setw(9) << realtime["90"].get<double>() << std::setw(9)
          << realtime["120"].get<double>() << std::setw(9) << realtime["144"].get<double>() << std::setw(9)
-         << c.threads << std::setprecision(1) << std::setw(11) << c.peak_rss_mib << "\n";
+         << c.threads << std::setprecision(1) << std::setw(11) << c.peak_rss_mib << std::setprecision(2) << std::setw(13)
+         << 1e3 * median(c.cpu_seconds) / link_frames << "\n";
   }
   const Json& hw = result["hw_report_memory"];
   text << "  hw-report memory: " << std::fixed << std::setprecision(1) << hw["on_chip_mib"].get<double>()
@@ -273,6 +298,9 @@ void register_bench(CLI::App& app, Action& action) {
   cmd->add_option("--threads", options->threads,
                   "Threads of the streaming decoder (bands of output lines; default: the machine's hardware threads)")
       ->check(CLI::Range(1, kMaxDecoderThreads));
+  cmd->add_option("--only", options->only,
+                  "Time only these contenders (repeatable) besides opencv-float32, the yardstick of every ratio")
+      ->check(CLI::IsMember(kContenders));
   cmd->callback([options, &action] {
     action = [options] {
       BenchOptions o = *options;

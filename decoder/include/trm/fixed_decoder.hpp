@@ -162,6 +162,10 @@ struct FixedDecoderConfig {
   // own line buffers (two pipelines side by side, as a wider controller would run them). Views pushed line by line
   // and views with lost lines run on one. In [1, kMaxDecoderThreads].
   int threads = 1;
+  // The streaming and frame schedules' hot steps over whole lines in SIMD lanes (U with each d row blended along x
+  // once, the EOTF, Eq. 2, the OLED drive code search), where the formats fit the lanes (8-bit link sums, see
+  // fixed_lines.hpp); false runs the per-sample stage functions everywhere, the path the line kernels are held to.
+  bool line_kernels = true;
 
   // Throws std::invalid_argument naming the stage whose format or table is unusable.
   void validate() const;

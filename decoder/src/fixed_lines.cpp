@@ -1,0 +1,305 @@
+// The line kernels of fixed_lines.hpp, compiled once per x86 instruction set by Highway's foreach_target and chosen
+// at run time. Every product is formed from operands that fit 32 bits (MulEven), which is what the plans' format
+// checks guarantee; the tails shorter than a vector run the same arithmetic on scalars.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "fixed_lines.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+#include "fixed_kernels.hpp"
+#include "fixed_lines.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+
+HWY_BEFORE_NAMESPACE();
+namespace trm::fixed_detail::lines {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// Scalar forms, for the tails (the same expressions as the vector bodies and as the stage functions).
+inline std::int64_t eotf_scalar(std::uint64_t blended, const EotfPlan& p) {
+  const std::uint64_t upsampled = (blended + (std::uint64_t{1} << (p.blend_shift - 1))) >> p.blend_shift;
+  const std::size_t node = static_cast<std::size_t>(upsampled >> p.weight_bits);
+  const auto weight = static_cast<std::int64_t>(upsampled & ((std::uint64_t{1} << p.weight_bits) - 1));
+  const std::int64_t exact = p.node[node] * (std::int64_t{1} << p.weight_bits) + p.step[node] * weight;
+  return (exact + (std::int64_t{1} << (p.weight_bits - 1))) >> p.weight_bits;
+}
+
+inline std::uint16_t drive_scalar(std::int64_t x, std::size_t s, const DrivePlan& p) {
+  const auto u = static_cast<std::uint64_t>(x);
+  const int lead = static_cast<int>(std::bit_width(u)) - 1;
+  const int m = p.mantissa_bits;
+  const std::int64_t bucket =
+      lead < m ? static_cast<std::int64_t>(u)
+               : (static_cast<std::int64_t>(lead - m + 1) << m) +
+                     static_cast<std::int64_t>((u >> (lead - m)) & ((std::uint64_t{1} << m) - 1));
+  const std::size_t channel = s % 3;
+  std::int64_t k = p.base[static_cast<std::size_t>(p.bucket_offset[channel] + bucket)];
+  for (int i = 0; i < p.steps; ++i) k += x >= p.thresholds[static_cast<std::size_t>(k + 1)] ? 1 : 0;
+  return static_cast<std::uint16_t>(k - p.threshold_offset[channel]);
+}
+
+// The scalar target (x86-64 CPUs without SSSE3) has one lane, where the vector bodies' lane pairing does not apply:
+// there the tails' loops do the whole line.
+void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
+#if HWY_TARGET == HWY_SCALAR
+  for (std::size_t s = 0; s < n; ++s) {
+    const std::uint32_t w = plan.upper[s];
+    out[s] = (plan.unit - w) * row[static_cast<std::size_t>(plan.left[s])] + w * row[static_cast<std::size_t>(plan.right[s])];
+  }
+#else
+  const std::size_t row_samples = static_cast<std::size_t>(std::max(plan.left.back(), plan.right.back())) + 1;
+  const hn::ScalableTag<std::uint32_t> du;
+  const hn::RebindToSigned<decltype(du)> di;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const std::size_t lanes = hn::Lanes(du);
+  const auto unit = hn::Set(du, plan.unit);
+  // The reduced row's samples widened once, so the taps are 32-bit gathers.
+  thread_local std::vector<std::uint32_t> wide;
+  wide.resize(row_samples + lanes);
+  std::size_t i = 0;
+  for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
+  for (; i < row_samples; ++i) wide[i] = row[i];
+  std::size_t s = 0;
+  for (; s + lanes <= n; s += lanes) {
+    const auto a = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.left.data() + s));
+    const auto b = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.right.data() + s));
+    const auto w = hn::LoadU(du, plan.upper.data() + s);
+    hn::StoreU(hn::Add(hn::Mul(hn::Sub(unit, w), a), hn::Mul(w, b)), du, out + s);
+  }
+  for (; s < n; ++s) {
+    const std::uint32_t w = plan.upper[s];
+    out[s] = (plan.unit - w) * wide[static_cast<std::size_t>(plan.left[s])] + w * wide[static_cast<std::size_t>(plan.right[s])];
+  }
+#endif
+}
+
+void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                   const EotfPlan& p, std::int64_t* out) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Rebind<std::uint32_t, decltype(du)> d32h;  // half-width loads of the uQb.W rows
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Repartition<std::int32_t, decltype(d)> di32;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto lower_weight = hn::BitCast(du32, hn::Set(du, p.unit - upper));
+  const auto upper_weight = hn::BitCast(du32, hn::Set(du, upper));
+  const auto blend_half = hn::Set(du, std::uint64_t{1} << (p.blend_shift - 1));
+  const auto weight_mask = hn::Set(du, (std::uint64_t{1} << p.weight_bits) - 1);
+  const auto weight_half = hn::Set(d, std::int64_t{1} << (p.weight_bits - 1));
+  for (; s + lanes <= n; s += lanes) {
+    const auto t = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, top + s)));
+    const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s)));
+    const auto blended = hn::Add(hn::MulEven(lower_weight, t), hn::MulEven(upper_weight, b));  // uQb.2W
+    const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), p.blend_shift);     // uQb.U
+    const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, p.weight_bits));
+    const auto weight = hn::BitCast(di32, hn::And(upsampled, weight_mask));
+    const auto y0 = hn::GatherIndex(d, p.node.data(), node);
+    const auto step = hn::BitCast(di32, hn::GatherIndex(d, p.step.data(), node));
+    const auto exact = hn::Add(hn::ShiftLeftSame(y0, p.weight_bits), hn::MulEven(step, weight));
+    hn::StoreU(hn::ShiftRightSame(hn::Add(exact, weight_half), p.weight_bits), d, out + s);
+  }
+#endif
+  for (; s < n; ++s) {
+    const std::uint64_t blended = static_cast<std::uint64_t>(p.unit - upper) * top[s] + static_cast<std::uint64_t>(upper) * bottom[s];
+    out[s] = eotf_scalar(blended, p);
+  }
+}
+
+void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, std::uint16_t* out) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Rebind<double, decltype(d)> df;
+  const std::size_t lanes = hn::Lanes(d);
+  const int m = p.mantissa_bits;
+  const auto small = hn::Set(d, std::int64_t{1} << m);
+  const auto limit = hn::Set(d, p.value_limit);
+  const auto zero = hn::Zero(d);
+  const auto mantissa_mask = hn::Set(du, (std::uint64_t{1} << m) - 1);
+  // A double holds x < 2^53 exactly: its exponent is x's leading-one position and the top m bits of its fraction are
+  // the m bits below it, which is the bucket the scalar index computes with a leading-zero count.
+  const auto exponent_bias = hn::Set(d, std::int64_t{1023} + m - 1);
+  const auto one = hn::Set(d, std::int64_t{1});
+  const std::size_t phase_step = lanes % 3;
+  std::size_t phase = 0;
+  for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
+    const auto x = hn::LoadU(d, linear + s);
+    if (!hn::AllFalse(d, hn::Or(hn::Lt(x, zero), hn::Not(hn::Lt(x, limit))))) {  // outside the index: generic search
+      for (std::size_t i = 0; i < lanes; ++i) out[s + i] = drive_scalar(linear[s + i], s + i, p);
+      continue;
+    }
+    const auto bits = hn::BitCast(du, hn::ConvertTo(df, x));
+    const auto exponent = hn::BitCast(d, hn::ShiftRight<52>(bits));
+    const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 52 - m), mantissa_mask));
+    const auto octave = hn::ShiftLeftSame(hn::Sub(exponent, exponent_bias), m);
+    const auto bucket = hn::IfThenElse(hn::Lt(x, small), x, hn::Add(octave, top_bits));
+    auto k = hn::GatherIndex(d, p.base.data(), hn::Add(bucket, hn::LoadU(d, p.bucket_offset.data() + phase)));
+    for (int i = 0; i < p.steps; ++i) {
+      const auto threshold = hn::GatherIndex(d, p.thresholds.data(), hn::Add(k, one));
+      k = hn::Add(k, hn::IfThenZeroElse(hn::Lt(x, threshold), one));
+    }
+    const auto code = hn::Sub(k, hn::LoadU(d, p.threshold_offset.data() + phase));
+    HWY_ALIGN std::int64_t wide[DrivePlan::kMaxLanes];
+    hn::Store(code, d, wide);
+    for (std::size_t i = 0; i < lanes; ++i) out[s + i] = static_cast<std::uint16_t>(wide[i]);
+  }
+#endif
+  for (; s < n; ++s) out[s] = drive_scalar(linear[s], s, p);
+}
+
+std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
+                         const std::int64_t* code_rom, std::int64_t one_value, std::int64_t* shown, std::int64_t* rho) {
+  std::uint64_t clipped = 0;
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::Rebind<std::uint16_t, decltype(d)> d16;
+  const hn::Rebind<std::uint32_t, decltype(d)> d32;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto one = hn::Set(d, one_value);
+  for (; s + lanes <= n; s += lanes) {
+    const auto code = hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(d32, hn::LoadU(d16, codes + s))));
+    const auto full = hn::GatherIndex(d, code_rom, code);
+    const auto beta = hn::Sub(hn::Add(full, full), hn::LoadU(d, low + s));
+    const auto clamped = hn::Min(hn::Max(beta, zero), one);
+    clipped += hn::CountTrue(d, hn::Not(hn::Eq(clamped, beta)));
+    hn::StoreU(clamped, d, shown + s);
+    hn::StoreU(hn::Sub(beta, clamped), d, rho + s);
+  }
+#endif
+  for (; s < n; ++s) {
+    const std::int64_t beta = 2 * code_rom[codes[s]] - low[s];
+    shown[s] = std::clamp(beta, std::int64_t{0}, one_value);
+    rho[s] = beta - shown[s];
+    clipped += shown[s] != beta ? 1 : 0;
+  }
+  return clipped;
+}
+
+const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace trm::fixed_detail::lines
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace trm::fixed_detail {
+
+FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
+  const FixedDecoderConfig& c = kernels.config();
+  FixedLinePlans plans;
+  if (!c.line_kernels) return plans;
+  plans.code_rom = kernels.code_rom();
+  plans.one = kernels.one();
+  const int F = c.linear_frac_bits;
+  const int W = c.bilinear_weight_frac_bits;
+  const int U = c.upsample_frac_bits;
+  const fx::InterpolatedLut* eotf = kernels.eotf_lut();
+  const int weight_bits = U - c.eotf_segments_per_code_log2;
+  // The lanes' bounds: U's column sums in 32 bits, its row sum in 64, the rounding shift and the ROM weight in the
+  // 32-bit operands of MulEven, the interpolation's exact sum in 63 bits, half-up rounding (as the ROM's).
+  const bool eotf_fits = !kernels.linear_space() && eotf != nullptr && W <= 31 &&
+                         (static_cast<std::uint64_t>(kernels.max_code()) << W) < (std::uint64_t{1} << 32) &&
+                         2 * W - U >= 1 && weight_bits >= 1 && weight_bits <= 31 && F + 1 + weight_bits <= 62 &&
+                         eotf->shape().rounding == fx::Quant::Rnd && !eotf->is_direct() && !eotf->is_octave_segmented();
+  if (eotf_fits) {
+    const std::vector<std::int64_t>& rom = eotf->rom();
+    const std::uint64_t top_node = (static_cast<std::uint64_t>(kernels.max_code()) << U) >> weight_bits;
+    EotfPlan e;
+    e.node = rom;
+    e.step.resize(rom.size(), 0);
+    bool steps_fit = top_node + 1 == rom.size();
+    for (std::size_t i = 0; i + 1 < rom.size(); ++i) {
+      e.step[i] = rom[i + 1] - rom[i];
+      steps_fit = steps_fit && e.step[i] >= INT32_MIN && e.step[i] <= INT32_MAX;
+    }
+    e.unit = std::uint32_t{1} << W;
+    e.blend_shift = 2 * W - U;
+    e.weight_bits = weight_bits;
+    if (steps_fit) plans.eotf = std::move(e);
+  }
+  if (!kernels.lcd()) {
+    DrivePlan d;
+    d.mantissa_bits = ThresholdIndex::kMantissaBits;
+    bool usable = true;
+    std::array<std::int64_t, 3> bucket_start{};
+    std::array<std::int64_t, 3> threshold_start{};
+    for (int ch = 0; ch < 3; ++ch) {
+      const ThresholdIndex& index = kernels.drive_index(ch);
+      usable = usable && index.steps() > 0 && index.value_bits() == kernels.drive_index(0).value_bits();
+      if (!usable) break;
+      bucket_start[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(d.base.size());
+      threshold_start[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(d.thresholds.size());
+      for (std::uint16_t code : index.base()) d.base.push_back(threshold_start[static_cast<std::size_t>(ch)] + code);
+      d.thresholds.insert(d.thresholds.end(), index.padded().begin(), index.padded().end());
+      // More steps than a channel needs stop at its code (its thresholds increase, then the padding no x reaches).
+      d.steps = std::max(d.steps, index.steps());
+    }
+    if (usable) {
+      d.value_limit = std::int64_t{1} << kernels.drive_index(0).value_bits();
+      for (int i = 0; i < 3 + DrivePlan::kMaxLanes; ++i) {
+        d.bucket_offset.push_back(bucket_start[static_cast<std::size_t>(i % 3)]);
+        d.threshold_offset.push_back(threshold_start[static_cast<std::size_t>(i % 3)]);
+      }
+      plans.drive = std::move(d);
+    }
+  }
+  return plans;
+}
+
+ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
+  ColumnBlendPlan plan;
+  plan.unit = unit;
+  const std::size_t samples = 3 * static_cast<std::size_t>(g.full.width);
+  plan.left.resize(samples);
+  plan.right.resize(samples);
+  plan.upper.resize(samples);
+  for (int x = 0; x < g.full.width; ++x) {
+    const BilinearWeights& col = g.bilinear_cols[static_cast<std::size_t>(x)];
+    for (int ch = 0; ch < 3; ++ch) {
+      const std::size_t s = 3 * static_cast<std::size_t>(x) + static_cast<std::size_t>(ch);
+      plan.left[s] = 3 * col.i0 + ch;
+      plan.right[s] = 3 * col.i1 + ch;
+      plan.upper[s] = static_cast<std::uint32_t>(col.upper);
+    }
+  }
+  return plan;
+}
+
+}  // namespace trm::fixed_detail
+
+namespace trm::fixed_detail::lines {
+
+HWY_EXPORT(BlendColumns);
+HWY_EXPORT(BlendRowsEotf);
+HWY_EXPORT(DriveCodes);
+HWY_EXPORT(Compensate);
+HWY_EXPORT(TargetName);
+
+void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
+  HWY_DYNAMIC_DISPATCH(BlendColumns)(row, plan, n, out);
+}
+void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                     const EotfPlan& plan, std::int64_t* out) {
+  HWY_DYNAMIC_DISPATCH(BlendRowsEotf)(top, bottom, n, upper, plan, out);
+}
+void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(DriveCodes)(linear, n, plan, out);
+}
+std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
+                         const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho) {
+  return HWY_DYNAMIC_DISPATCH(Compensate)(codes, low, n, code_rom, one, shown, rho);
+}
+const char* target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
+
+}  // namespace trm::fixed_detail::lines
+#endif

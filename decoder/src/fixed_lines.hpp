@@ -1,0 +1,83 @@
+// The streaming decoder's hot per-line steps over contiguous lanes, vectorised with Google Highway and dispatched at
+// run time to the widest instruction set the CPU offers (the binary still runs on any x86-64). Each kernel gives the
+// same bits as the per-sample stage functions of fixed_kernels.hpp for the formats FixedLinePlans accepts; the
+// core keeps the per-sample path for every other format and for the work these do not cover (taps, report planes,
+// lost lines, the LCD merge).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace trm::fixed_detail {
+
+class FixedKernels;
+struct Geometry;
+
+// U's column blend of one reduced row, one entry per output sample s = 3x + ch of the full-width line: the row
+// samples of the column's two taps and the weight of the right one, uQ0.W. The exact sum (2^W - w) a + w b is kept
+// unrounded (uQb.W), so U = the row blend of two of these, exactly as FixedKernels::blend computes it.
+struct ColumnBlendPlan {
+  std::vector<std::int32_t> left;
+  std::vector<std::int32_t> right;
+  std::vector<std::uint32_t> upper;
+  std::uint32_t unit = 0;  // 2^W
+};
+
+// U's row blend, its rounding to uQb.U and the EOTF ROM interpolation (FixedKernels::linear_of_upsampled): node y_i
+// and step y_{i+1} - y_i per ROM word, the last step 0 (so the top code, whose weight is 0, reads the last word).
+struct EotfPlan {
+  std::vector<std::int64_t> node;
+  std::vector<std::int64_t> step;
+  std::uint32_t unit = 0;  // 2^W
+  int blend_shift = 0;     // 2W - U
+  int weight_bits = 0;     // U - k
+};
+
+// The OLED drive code search (ThresholdIndex) of the three channels in one table each, for interleaved samples:
+// sample s reads channel s mod 3's part through its offsets.
+struct DrivePlan {
+  std::vector<std::int64_t> base;        // the code at each bucket's lower end, plus the channel's threshold offset
+  std::vector<std::int64_t> thresholds;  // every channel's padded threshold ROM, one after the other
+  // Element i: channel i mod 3's first bucket / first threshold, for i < 3 + kMaxLanes, so that the offsets of the
+  // samples s0.. of a vector are the elements (s0 mod 3)..
+  static constexpr int kMaxLanes = 64;
+  std::vector<std::int64_t> bucket_offset;
+  std::vector<std::int64_t> threshold_offset;
+  int steps = 0;
+  int mantissa_bits = 0;
+  std::int64_t value_limit = 0;  // 2^value_bits: larger values take the generic search
+};
+
+// What the line kernels need from a configuration, or nothing where its formats do not fit their lanes.
+struct FixedLinePlans {
+  std::optional<EotfPlan> eotf;    // encoded-space U and EOTF (8-bit sums, W <= 24, 2W > U, interpolation on 64 bits)
+  std::optional<DrivePlan> drive;  // OLED drive codes
+  std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
+  std::int64_t one = 0;
+
+  static FixedLinePlans build(const FixedKernels& kernels);
+};
+
+// The column blend plan of a view size (for FixedLinePlans::eotf).
+ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit);
+
+namespace lines {
+
+// out[s] = (2^W - upper[s]) row[left[s]] + upper[s] row[right[s]] for s < n (uQb.W, exact).
+void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out);
+// out[s] = lin(round((2^W - upper) top[s] + upper bottom[s]) to uQb.U) through the EOTF ROM, uQ1.F.
+void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                     const EotfPlan& plan, std::int64_t* out);
+// out[s] = the drive code of linear[s] (channel s mod 3), as ThresholdIndex::search gives it.
+void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
+// Eq. 2 and the split (FixedKernels::compensate): beta = 2 lin(codes[s]) - low[s], shown[s] = clamp(beta, 0, one),
+// rho[s] = beta - shown[s]. Returns the number of clipped samples (beta outside [0, one]).
+std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
+                         const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho);
+// The instruction set the kernels dispatch to on this CPU (e.g. "AVX3", "AVX2", "SSE4").
+const char* target_name();
+
+}  // namespace lines
+}  // namespace trm::fixed_detail
