@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "perception_checks.hpp"
@@ -15,8 +16,8 @@ using perception_detail::number_text;
 using perception_detail::reject;
 
 constexpr const char* kWhere = "LcResponse";
-constexpr int kMaxOverdriveGrid = 4096;
 constexpr double kNeverRisesTauS = 1e30;
+constexpr int kMostNewtonSteps = 100;
 
 }  // namespace
 
@@ -28,20 +29,9 @@ LcResponse::LcResponse(const LcResponseParams& params, double frame_period_s) : 
   if (!(params.drive_gamma >= 0.5 && params.drive_gamma <= 4.0)) {
     reject(kWhere, "drive_gamma", "must be in [0.5, 4], got " + number_text(params.drive_gamma));
   }
-  if (params.overdrive_grid != 0 && (params.overdrive_grid < 2 || params.overdrive_grid > kMaxOverdriveGrid)) {
-    reject(kWhere, "overdrive_grid",
-           "must be 0 (no overdrive) or in [2, " + std::to_string(kMaxOverdriveGrid) + "], got " +
-               std::to_string(params.overdrive_grid));
-  }
   perception_detail::require_positive(kWhere, "frame_period_s", frame_period_s);
   period_ = frame_period_s;
-  const int n = params.overdrive_grid;
-  lut_.resize(static_cast<std::size_t>(n) * n);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      lut_[static_cast<std::size_t>(i) * n + j] = exact_overdrive(double(i) / (n - 1), double(j) / (n - 1));
-    }
-  }
+  fall_reach_ = -std::expm1(-period_ / params.tau_off_s);
 }
 
 double LcResponse::rise_tau_s(double drive) const {
@@ -56,35 +46,38 @@ double LcResponse::advance(double state, double drive, double seconds) const {
   return drive + (state - drive) * std::exp(-seconds / tau_s(state, drive));
 }
 
-double LcResponse::exact_overdrive(double state, double level) const {
-  // The frame's end state is increasing in the drive (τ_on falls as the drive rises, and a falling segment is linear
-  // in it), continuous at drive = state, so bisection on [0, 1] finds the one drive, clamped where none reaches.
-  const auto end = [&](double drive) { return advance(state, drive, period_); };
-  if (end(1.0) <= level) return 1.0;
-  if (end(0.0) >= level) return 0.0;
-  double lo = 0.0, hi = 1.0;
-  while (hi - lo > 1e-15) {
-    const double mid = 0.5 * (lo + hi);
-    (end(mid) < level ? lo : hi) = mid;
+double LcResponse::overdrive(double state, double level) const {
+  if (level == state) return level;
+  if (level < state) {
+    // A falling segment's τ is τ_off whatever the drive: the end state x + (p − x) reach is linear in p.
+    return fall_reach_ > 0.0 ? std::max(0.0, state + (level - state) / fall_reach_) : 0.0;
   }
-  return 0.5 * (lo + hi);
-}
-
-double LcResponse::drive_for(double state, double level) const {
-  const int n = params_.overdrive_grid;
-  if (n == 0 || !(state >= 0.0 && state <= 1.0 && level >= 0.0 && level <= 1.0)) return level;
-  const double u = state * (n - 1), w = level * (n - 1);
-  const int i = std::min(static_cast<int>(u), n - 2), j = std::min(static_cast<int>(w), n - 2);
-  const double fu = u - i, fw = w - j;
-  const auto at = [&](int a, int b) { return lut_[static_cast<std::size_t>(a) * n + b]; };
-  const double low = at(i, j) + (at(i, j + 1) - at(i, j)) * fw;
-  const double high = at(i + 1, j) + (at(i + 1, j + 1) - at(i + 1, j)) * fw;
-  return std::clamp(low + (high - low) * fu, 0.0, 1.0);
-}
-
-LcSegment LcResponse::segment(double state, double level) const {
-  const double drive = drive_for(state, level);
-  return {drive, tau_s(state, drive)};
+  // Rising: h(p) = (p − x) reach(p) − (L − x), reach(p) = 1 − e^{−T/τ_on(p)}, increasing in p on (x, 1] (a larger step
+  // that also rises faster).
+  const double gap = level - state;
+  const double ratio = params_.drive_ratio - 1.0, exponent = 1.0 / params_.drive_gamma;
+  const auto reach = [&](double drive) { return -std::expm1(-period_ / rise_tau_s(drive)); };
+  const auto excess = [&](double drive) { return (drive - state) * reach(drive) - gap; };
+  if (excess(1.0) <= 0.0) return 1.0;
+  // τ_on(L) >= τ_on(p*), so the drive that would reach L at τ_on(L) is at or above the root: the upper bracket.
+  double lo = level, hi = std::min(1.0, state + gap / reach(level));
+  double drive = hi;
+  for (int step = 0; step < kMostNewtonSteps; ++step) {
+    const double value = excess(drive);
+    if (value == 0.0) return drive;
+    (value < 0.0 ? lo : hi) = drive;
+    // h'(p) = reach + (p − x) e^{−T/τ} (T/τ) 2V V' / (V² − 1), V' = (V_max/V_th − 1) p^{1/γ_d − 1} / γ_d.
+    const double tau = rise_tau_s(drive);
+    const double voltage = 1.0 + ratio * std::pow(drive, exponent);
+    const double slope_v = ratio * exponent * std::pow(drive, exponent - 1.0);
+    const double slope = reach(drive) + (drive - state) * std::exp(-period_ / tau) * (period_ / tau) * 2.0 *
+                                            voltage * slope_v / ((voltage - 1.0) * (voltage + 1.0));
+    double next = drive - value / slope;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - drive) <= 4.0 * std::numeric_limits<double>::epsilon() * drive) return next;
+    drive = next;
+  }
+  return drive;
 }
 
 }  // namespace trm

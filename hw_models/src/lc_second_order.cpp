@@ -68,6 +68,14 @@ LcMotion LcSecondOrder::end_of_frame(const LcMotion& start, double drive) const 
   return {drive + frame_[0] * z0 + frame_[1] * z1, (frame_[2] * z0 + frame_[3] * z1) / params_.tau_s};
 }
 
+double LcSecondOrder::overdrive(const LcMotion& start, double level) const {
+  const double gain = 1.0 - frame_[0];
+  const double rest = frame_[0] * start.level + frame_[1] * params_.tau_s * start.rate_per_s;
+  // A crystal so slow that one frame's drive moves nothing (gain rounds to 0): no drive does better than the level.
+  if (!(gain > 0.0)) return level;
+  return std::clamp((level - rest) / gain, 0.0, 1.0);
+}
+
 LcMotionWeights LcSecondOrder::weights(double t0, double t1) const {
   constexpr const char* kWeights = "LcSecondOrder::weights";
   if (!(std::isfinite(t0) && t0 >= 0.0)) reject(kWeights, "t0", "must be finite and >= 0, got " + number_text(t0));

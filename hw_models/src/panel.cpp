@@ -431,6 +431,7 @@ void write_panel(Json& out, const Panel& panel) {
     out["lc_second_order"] = {{"tau_s", lcd.lc_second_order->tau_s},
                               {"damping_ratio", lcd.lc_second_order->damping_ratio}};
   }
+  if (lcd.overdrive) out["overdrive"] = true;
 }
 
 [[noreturn]] void reject_json(const std::string& why) { throw std::invalid_argument("panel JSON: " + why); }
@@ -482,6 +483,13 @@ void read_panel(const Json& in, Panel& panel) {
         }
       }
       out.lcd.lc_second_order = LcSecondOrderParams{number_field(*lc, "tau_s"), number_field(*lc, "damping_ratio")};
+    }
+    if (const auto overdrive = in.find("overdrive"); overdrive != in.end()) {
+      if (!overdrive->is_boolean()) {
+        reject_json("\"overdrive\" must be true or false (the panel overdrives its liquid crystal), got " +
+                    overdrive->dump());
+      }
+      out.lcd.overdrive = overdrive->template get<bool>();
     }
   } else {
     reject_json("\"kind\" must be \"oled\" or \"lcd\", got " + kind.dump());

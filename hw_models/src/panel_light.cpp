@@ -55,12 +55,16 @@ PanelLight::PanelLight(const PanelLightConfig& config) : config_(config) {
   if (config.lc_response && config.lc_second_order) {
     reject(kWhere, "lc_second_order", "cannot be set together with lc_response (one LC model)");
   }
+  if (config.overdrive && !(config.lc_tau_s > 0.0 || config.lc_response || config.lc_second_order)) {
+    reject(kWhere, "overdrive", "needs a liquid crystal to overdrive (lc_tau_s > 0, lc_response or lc_second_order)");
+  }
   period_ = 1.0 / config.refresh_hz;
   if (config.lc_response) response_.emplace(*config.lc_response, period_);
   if (config.lc_second_order) second_order_.emplace(*config.lc_second_order, period_);
   window_begin_ = config.window_start * period_;
   window_end_ = std::min(period_, (config.window_start + config.duty) * period_);
   decay_ = config.lc_tau_s > 0.0 ? std::exp(-period_ / config.lc_tau_s) : 0.0;
+  reach_ = config.lc_tau_s > 0.0 ? -std::expm1(-period_ / config.lc_tau_s) : 1.0;
 }
 
 double PanelLight::row_delay_s(int y, int rows) const {
@@ -71,15 +75,25 @@ double PanelLight::row_delay_s(int y, int rows) const {
   return config_.scan_out == ScanOut::Rolling ? period_ * y / rows : 0.0;
 }
 
+double PanelLight::drive(const LcMotion& previous_state, double level) const {
+  const double state = previous_state.level;
+  if (!config_.overdrive || !(state >= 0.0 && state <= 1.0 && level >= 0.0 && level <= 1.0)) return level;
+  if (second_order_) return second_order_->overdrive(previous_state, level);
+  if (response_) return response_->overdrive(state, level);
+  // One τ for every transition: the end state s0 + (p − s0)(1 − e^{−T/τ}) is linear in p.
+  return reach_ > 0.0 ? std::clamp(state + (level - state) / reach_, 0.0, 1.0) : level;
+}
+
 LcSegment PanelLight::segment(double previous_state, double level) const {
-  if (response_) return response_->segment(previous_state, level);
-  return {level, config_.lc_tau_s};
+  const double driven = drive(previous_state, level);
+  if (response_) return response_->segment(previous_state, driven);
+  return {driven, config_.lc_tau_s};
 }
 
 double PanelLight::level_at(double t, const LcMotion& previous_state, double level) const {
   if (!second_order_) return level_at(t, previous_state.level, level);
   if (!(t >= window_begin_ && t < window_end_)) return 0.0;
-  return second_order_->advance(previous_state, level, t).level / config_.duty;
+  return second_order_->advance(previous_state, drive(previous_state, level), t).level / config_.duty;
 }
 
 double PanelLight::level_at(double t, double previous_state, double level) const {
@@ -125,7 +139,8 @@ LightWeights PanelLight::weights(double t0, double t1, double tau) const {
 double PanelLight::integral(double t0, double t1, const LcMotion& previous_state, double level) const {
   if (!second_order_) return integral(t0, t1, previous_state.level, level);
   const LightWeights w = weights(t0, t1);
-  return w.level * level + w.previous * previous_state.level + w.previous_rate * previous_state.rate_per_s;
+  return w.level * drive(previous_state, level) + w.previous * previous_state.level +
+         w.previous_rate * previous_state.rate_per_s;
 }
 
 double PanelLight::integral(double t0, double t1, double previous_state, double level) const {
@@ -136,7 +151,7 @@ double PanelLight::integral(double t0, double t1, double previous_state, double 
 }
 
 LcMotion PanelLight::end_state(const LcMotion& previous_state, double level) const {
-  if (second_order_) return second_order_->end_of_frame(previous_state, level);
+  if (second_order_) return second_order_->end_of_frame(previous_state, drive(previous_state, level));
   return {end_state(previous_state.level, level), 0.0};
 }
 
@@ -144,8 +159,9 @@ double PanelLight::end_state(double previous_state, double level) const {
   if (second_order_) {
     throw std::logic_error("PanelLight::end_state: the second-order LC's state has a rate; pass an LcMotion");
   }
-  if (response_) return response_->advance(previous_state, response_->drive_for(previous_state, level), period_);
-  return level + (previous_state - level) * decay_;
+  const double driven = drive(previous_state, level);
+  if (response_) return response_->advance(previous_state, driven, period_);
+  return driven + (previous_state - driven) * decay_;
 }
 
 PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOptions& options) {
@@ -164,6 +180,7 @@ PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOp
     }
     config.window_start = options.strobe_start < 0.0 ? 1.0 - options.strobe_duty : options.strobe_start;
     config.lc_tau_s = 0.0;
+    config.overdrive = panel.lcd.overdrive;
     if (panel.lcd.lc_second_order) {
       config.lc_second_order = panel.lcd.lc_second_order;
     } else {
@@ -174,5 +191,19 @@ PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOp
 }
 
 double steady_level(const Panel& panel, double v, int channel) { return panel.linear_from_drive(v, channel); }
+
+cv::Mat steady_levels(const Panel& panel, int output_bits, const cv::Mat& drive_codes) {
+  if (drive_codes.type() != CV_16UC3) reject("steady_levels", "drive_codes", "must be CV_16UC3 drive codes");
+  const double top = std::ldexp(1.0, output_bits) - 1.0;
+  cv::Mat levels(drive_codes.size(), CV_64FC3);
+  for (int y = 0; y < drive_codes.rows; ++y) {
+    const auto* code = drive_codes.ptr<cv::Vec3w>(y);
+    auto* out = levels.ptr<cv::Vec3d>(y);
+    for (int x = 0; x < drive_codes.cols; ++x) {
+      for (int c = 0; c < 3; ++c) out[x][c] = steady_level(panel, code[x][c] / top, c);
+    }
+  }
+  return levels;
+}
 
 }  // namespace trm

@@ -137,7 +137,8 @@ enum class Steps {
 
 // One scan line through K frames: the panel light of each step (exact), shifted by the moving frame's position at
 // the step's middle.
-void line_pass(const std::vector<const double*>& frames, Line line, const double* previous, const PanelLight& light,
+void line_pass(const std::vector<const double*>& frames, Line line, const double* previous,
+               const double* previous_rate, const PanelLight& light,
                double velocity_px_s, double delay_s, double origin_s, int substeps, Steps steps,
                const std::vector<double*>& out_rows) {
   const double period = light.frame_period_s();
@@ -151,12 +152,20 @@ void line_pass(const std::vector<const double*>& frames, Line line, const double
   // The second-order LC also carries each pixel's rate (from rest at the start), with weights shared by all pixels.
   const bool second_order = light.lc_second_order().has_value();
   std::vector<double> rate(second_order ? samples : 0, 0.0);
+  if (second_order && previous_rate) std::copy(previous_rate, previous_rate + samples, rate.begin());
   std::vector<LcSegment> segments(per_pixel ? samples : 0);
   std::vector<double> step_light(per_pixel ? samples : 0);
+  // With shared weights an overdriven frame's light is still linear in its drive, which differs per pixel.
+  const bool overdriven = light.config().overdrive && !per_pixel;
+  std::vector<double> drives(overdriven ? samples : 0);
   const double begin = steps == Steps::Lit ? light.window_begin_s() : 0.0;
   const double end = steps == Steps::Lit ? light.window_end_s() : period;
   for (int f = 0; f < frame_count; ++f) {
     for (std::size_t i = 0; i < segments.size(); ++i) segments[i] = light.segment(state[i], frames[f][i]);
+    for (std::size_t i = 0; i < drives.size(); ++i) {
+      drives[i] = light.drive(LcMotion{state[i], second_order ? rate[i] : 0.0}, frames[f][i]);
+    }
+    const double* driven = overdriven ? drives.data() : frames[f];
     for (int k = 0; k < substeps; ++k) {
       const double t0 = begin + (end - begin) * k / substeps;
       const double t1 = k + 1 == substeps ? end : begin + (end - begin) * (k + 1) / substeps;
@@ -173,7 +182,7 @@ void line_pass(const std::vector<const double*>& frames, Line line, const double
         continue;
       }
       const LightWeights w = light.weights(t0, t1);
-      add_shifted(frames[f], line, shift, w.level * scale, dst);
+      add_shifted(driven, line, shift, w.level * scale, dst);
       if (has_history) add_shifted(state.data(), line, shift, w.previous * scale, dst);
       if (second_order) add_shifted(rate.data(), line, shift, w.previous_rate * scale, dst);
     }
@@ -220,7 +229,7 @@ cv::Mat scan_line_pass(const char* where, const cv::Mat& frames, const PanelLigh
   cv::Mat out = cv::Mat::zeros(out_rows, frames.cols, frames.type());
   std::vector<double*> out_ptrs;
   for (int m = 0; m < out_rows; ++m) out_ptrs.push_back(out.ptr<double>(m));
-  line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(0), light,
+  line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(0), nullptr, light,
             velocity_deg_s * viewer.pixels_per_degree, light.row_delay_s(options.row, options.rows), options.origin_s,
             options.substeps, steps, out_ptrs);
   return out;
@@ -304,7 +313,8 @@ double xt_samples_per_second(const PanelLight& light, int substeps) {
 }
 
 cv::Mat retinal_image(const std::vector<cv::Mat>& frames, const PanelLight& light, const Viewer& viewer,
-                      double eye_velocity_deg_s, const RetinaOptions& options, const cv::Mat& previous) {
+                      double eye_velocity_deg_s, const RetinaOptions& options, const cv::Mat& previous,
+                      const cv::Mat& previous_rate) {
   constexpr const char* kWhere = "retinal_image";
   if (frames.empty()) reject(kWhere, "frames", "must hold at least one frame");
   for (const cv::Mat& frame : frames) {
@@ -323,6 +333,12 @@ cv::Mat retinal_image(const std::vector<cv::Mat>& frames, const PanelLight& ligh
     }
     require_levels(kWhere, "previous", previous);
   }
+  if (!previous_rate.empty()) {
+    if (previous.empty() || previous_rate.size() != frames[0].size() || previous_rate.type() != frames[0].type()) {
+      reject(kWhere, "previous_rate", "must come with `previous` and have the frames' size and type");
+    }
+    if (!cv::checkRange(previous_rate)) reject(kWhere, "previous_rate", "must be finite");
+  }
   const int height = frames[0].rows;
   const Line line{frames[0].cols, frames[0].channels()};
   cv::Mat out = cv::Mat::zeros(frames[0].size(), frames[0].type());
@@ -332,7 +348,8 @@ cv::Mat retinal_image(const std::vector<cv::Mat>& frames, const PanelLight& ligh
     std::vector<const double*> rows(frames.size());
     for (int y = range.start; y < range.end; ++y) {
       for (std::size_t f = 0; f < frames.size(); ++f) rows[f] = frames[f].ptr<double>(y);
-      line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(y), light, velocity_px_s,
+      line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(y),
+                previous_rate.empty() ? nullptr : previous_rate.ptr<double>(y), light, velocity_px_s,
                 light.row_delay_s(y, height), options.origin_s, options.substeps, Steps::Lit, {out.ptr<double>(y)});
     }
   });

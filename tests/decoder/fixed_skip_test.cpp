@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -176,6 +177,36 @@ TEST(FixedSkip, GreyLinesComputeOneChannelWithTheSameBits) {
   const SkipRun colour = decode_both_ways(encode_sequence(scene_images("panorama", 16, 16, 2), link), config, "colour");
   ASSERT_FALSE(HasFatalFailure());
   EXPECT_EQ(colour.counts[0].grey_lines + colour.counts[1].grey_lines, 0u);
+}
+
+// The off-chip traffic the skips save, by hand. A flat grey 16x8 view at r = 1/2 (8x4 reduced),
+// static, on the OLED at the default formats (residual sQ2.28: 30 bits, linear F = 28, 8-bit link and drive): D of a
+// flat image is the image, so beta = I and rho = 0 on every line, and the reduced frame is d_t code for code.
+TEST(FixedSkip, TrafficSavedIsTheCountersTimesTheStoreWidths) {
+  const EncoderConfig link = link_config(0.5);
+  const FixedDecoderConfig config = fixed_config(link, "vive");
+  ASSERT_EQ(config.residual.width(), 30);
+  ASSERT_EQ(config.linear_frac_bits, 28);
+  const std::vector<cv::Mat> images(2, cv::Mat(8, 16, CV_64FC3, cv::Scalar(0.4, 0.4, 0.4)));
+  const SkipRun run = decode_both_ways(encode_sequence(images, link), config, "flat");
+  ASSERT_FALSE(HasFatalFailure());
+  FixedStageCounts total = run.counts[0];
+  total += run.counts[1];
+  EXPECT_EQ(total.residual_write_lines_skipped, 8u);  // the full frame's 8 lines, all rho = 0
+  EXPECT_EQ(total.residual_read_lines_skipped, 8u);   // the reduced frame's 8 lines
+  EXPECT_EQ(total.motion_test_lines_skipped, 8u);
+  const FixedSkipTraffic t = skip_traffic_saved(config, cv::Size(16, 8), total, 2);
+  EXPECT_EQ(t.residual_write_bits, 8 * (3 * 16) * 30);   // 11,520
+  EXPECT_EQ(t.residual_read_bits, 8 * (3 * 16) * 30);    // 11,520
+  EXPECT_EQ(t.previous_low_read_bits, 8 * 2 * (3 * 8) * 8);  // two d_{t-1} rows of 8 pixels per line: 3,072
+  EXPECT_EQ(t.lcd_store_bits, 2 * (3 * 16 * 8) * (8 + 2 * 31));  // v read, x read and write, 2 views: 53,760
+  EXPECT_EQ(t.total_bits(), 79872);
+  // The LCD keeps its stores; its other savings are the same arithmetic.
+  const FixedDecoderConfig lcd = fixed_config(link, "lcd");
+  EXPECT_EQ(skip_traffic_saved(lcd, cv::Size(16, 8), total, 2).lcd_store_bits, 0);
+  EXPECT_EQ(skip_traffic_saved(lcd, cv::Size(16, 8), total, 2).residual_write_bits, t.residual_write_bits);
+  EXPECT_THROW(skip_traffic_saved(config, cv::Size(0, 8), total, 2), std::invalid_argument);
+  EXPECT_THROW(skip_traffic_saved(config, cv::Size(16, 8), total, -1), std::invalid_argument);
 }
 
 // A smooth, dim scene never clips: no full line is written to the residual store and no reduced line reads one.

@@ -222,6 +222,87 @@ TEST(LcSecondOrder, PanelLightUsesItsStateAndRateAndTheRetinaAveragesIt) {
   }
 }
 
+TEST(LcSecondOrder, OverdriveEndsTheFrameAtTheTargetFromTheLevelAndTheRateOrClampsToTheNearest) {
+  // τ = 4 ms at 90 Hz (a frame is 2.8 natural times): many targets are out of one frame's reach. A run of targets,
+  // the rate carried from frame to frame; the oracle is the closed form at the drive the panel chose.
+  const double tau = 0.004;
+  for (const Real zeta : {1.0L, 1.6L}) {
+    PanelLightConfig config;
+    config.refresh_hz = 90.0;
+    config.lc_second_order = LcSecondOrderParams{tau, static_cast<double>(zeta)};
+    config.overdrive = true;
+    const PanelLight light(config);
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::vector<double> targets = {1.0, 0.0, 0.5, 0.5, 0.5, 0.9, 0.1};
+    for (int i = 0; i < 200; ++i) targets.push_back(uniform(random));
+    LcMotion state{0.2, 0.0};
+    int reached = 0, clamped = 0;
+    for (double level : targets) {
+      const double drive = light.drive(state, level);
+      const auto end_at = [&](Real p) { return p + analytic(tau, zeta, state.level - p, state.rate_per_s, kPeriod).deviation; };
+      if (drive > 0.0 && drive < 1.0) {
+        EXPECT_NEAR(static_cast<double>(end_at(drive)), level, 1e-12) << "from " << state.level << " to " << level;
+        ++reached;
+      } else {
+        // Clamped: even the whole drive range stops short, on the side the drive was clamped to.
+        ASSERT_TRUE(drive == 0.0 || drive == 1.0) << drive;
+        if (drive == 1.0) {
+          EXPECT_LE(static_cast<double>(end_at(1.0L)), level + 1e-12);
+        } else {
+          EXPECT_GE(static_cast<double>(end_at(0.0L)), level - 1e-12);
+        }
+        ++clamped;
+      }
+      const LcMotion next = light.end_state(state, level);
+      EXPECT_NEAR(next.level, static_cast<double>(end_at(drive)), 1e-13);
+      // The light of the frame is the closed form's at that drive too, and stays within the drive range.
+      EXPECT_NEAR(light.integral(0.0, kPeriod, state, level),
+                  static_cast<double>(Real(drive) * Real(kPeriod) +
+                                      analytic(tau, zeta, state.level - drive, state.rate_per_s, kPeriod).integral),
+                  1e-15);
+      EXPECT_GE(next.level, -1e-12);
+      EXPECT_LE(next.level, 1.0 + 1e-12);
+      state = next;
+    }
+    EXPECT_GT(reached, 50) << static_cast<double>(zeta);
+    EXPECT_GT(clamped, 20) << static_cast<double>(zeta);
+  }
+}
+
+TEST(LcSecondOrder, OverdrivenLightThroughTheRetinaCarriesTheDrive) {
+  // The retina's shared weights multiply each pixel's drive: a still eye sees the frames' integrals chained through
+  // end_state, with the rate of a moving start (previous_rate) carried in.
+  PanelLightConfig config;
+  config.refresh_hz = 90.0;
+  config.lc_second_order = LcSecondOrderParams{0.003, 1.0};
+  config.overdrive = true;
+  const PanelLight light(config);
+  cv::Mat frames(4, 1, CV_64FC3);
+  const double levels[4][3] = {{0.0, 1.0, 0.5}, {1.0, 0.2, 0.5}, {0.3, 0.9, 0.1}, {0.6, 0.6, 0.6}};
+  for (int n = 0; n < 4; ++n) {
+    for (int c = 0; c < 3; ++c) frames.at<cv::Vec3d>(n, 0)[c] = levels[n][c];
+  }
+  const cv::Mat previous(1, 1, CV_64FC3, cv::Scalar(0.4, 0.4, 0.4));
+  const cv::Mat previous_rate(1, 1, CV_64FC3, cv::Scalar(-50.0, 0.0, 80.0));
+  std::vector<cv::Mat> images;
+  for (int n = 0; n < 4; ++n) images.push_back(frames.row(n).clone());
+  RetinaOptions options;
+  options.substeps = 3;
+  const cv::Mat seen = retinal_image(images, light, custom_viewer(11.42), 0.0, options, previous, previous_rate);
+  for (int c = 0; c < 3; ++c) {
+    LcMotion state{0.4, previous_rate.at<cv::Vec3d>(0, 0)[c]};
+    double sum = 0.0;
+    for (int n = 0; n < 4; ++n) {
+      sum += light.integral(0.0, kPeriod, state, levels[n][c]);
+      state = light.end_state(state, levels[n][c]);
+    }
+    EXPECT_NEAR(seen.at<cv::Vec3d>(0, 0)[c], sum / (4 * kPeriod), 1e-13) << c;
+  }
+  expect_invalid([&] { retinal_image(images, light, custom_viewer(11.42), 0.0, options, {}, previous_rate); },
+                 "'previous_rate'");
+}
+
 TEST(LcSecondOrder, BadParametersAreRejectedByName) {
   expect_invalid([] { LcSecondOrder({0.0, 1.0}, kPeriod); }, "'tau_s'");
   expect_invalid([] { LcSecondOrder({std::nan(""), 1.0}, kPeriod); }, "'tau_s'");

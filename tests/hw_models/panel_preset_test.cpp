@@ -107,5 +107,37 @@ TEST(PanelPreset, SecondOrderCrystalIsSelectedByThePresetAndValidated) {
   }
 }
 
+TEST(PanelPreset, OverdriveIsSelectedByThePresetAndValidated) {
+  const Panel plain = parse_panel("lcd");
+  EXPECT_FALSE(nlohmann::json(plain).contains("overdrive"));  // the JSON of a preset without it is unchanged
+  EXPECT_FALSE(panel_light(plain, 90.0).config().overdrive);
+  for (const bool second_order : {false, true}) {
+    Panel panel = plain;
+    panel.lcd.overdrive = true;
+    if (second_order) panel.lcd.lc_second_order = LcSecondOrderParams{0.002, 1.0};
+    const std::filesystem::path path = write_file("overdrive.json", nlohmann::json(panel).dump(2));
+    const Panel read = parse_panel("lcd:" + path.string());
+    EXPECT_EQ(read, panel);
+    EXPECT_NE(read, plain);
+    const PanelLight light = panel_light(read, 90.0);
+    EXPECT_TRUE(light.config().overdrive);
+    EXPECT_EQ(light.lc_second_order().has_value(), second_order);
+    // From black to mid-grey the overdriven frame drives above the grey (and without overdrive, the grey).
+    EXPECT_GT(light.drive(0.0, 0.5), 0.5);
+    EXPECT_EQ(panel_light(plain, 90.0).drive(0.0, 0.5), 0.5);
+    std::filesystem::remove(path);
+  }
+  const std::string head = R"({"kind": "lcd", "name": "x", "p1": -0.1, "p2": 0.2, "p3": 0.5, "p4": 0, "gamma": 2.2, )";
+  for (const std::string tail : {R"("overdrive": 1})", R"("overdrive": "yes"})", R"("overdrive": null})"}) {
+    const std::filesystem::path file = write_file("bad_overdrive.json", head + tail);
+    const std::string message = rejection("lcd:" + file.string());
+    EXPECT_NE(message.find("\"overdrive\" must be true or false"), std::string::npos) << tail << ": " << message;
+    std::filesystem::remove(file);
+  }
+  const std::filesystem::path off = write_file("overdrive_off.json", head + R"("overdrive": false})");
+  EXPECT_FALSE(parse_panel("lcd:" + off.string()).lcd.overdrive);
+  std::filesystem::remove(off);
+}
+
 }  // namespace
 }  // namespace trm

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <cstdint>
@@ -66,6 +68,28 @@ TEST(Soak, LongRunPeakMemoryAndReportStayFlat) {
   EXPECT_EQ(count_lines(tmp.path() / "long" / "pairs.jsonl"), kLong / 2);
 }
 
+// The process's resident set now (pages of /proc/self/statm), in kB; -1 where it cannot be read.
+std::int64_t resident_kb() {
+  std::ifstream statm("/proc/self/statm");
+  std::int64_t size = 0, resident = -1;
+  if (!(statm >> size >> resident)) return -1;
+  return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+// Under AddressSanitizer freed memory waits in a quarantine that fills as a run goes on, so the resident set grows
+// for the sanitizer's sake; the in-process memory check is then left to LeakSanitizer.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kResidentSetMeaningful = false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kResidentSetMeaningful = false;
+#else
+constexpr bool kResidentSetMeaningful = true;
+#endif
+#else
+constexpr bool kResidentSetMeaningful = true;
+#endif
+
 // A still scene, the panel and phase it soaks on, and what its residual must be.
 struct SoakCase {
   const char* scene;
@@ -85,8 +109,11 @@ TEST_P(StillSoak, FixedPointDecoderKeepsTheResidualBoundedAndTheOutputPeriodic) 
   // those of the view two frames earlier, bit for bit: the state that lives through the run (rho, the kept d_t, the
   // LCD's panel history) cannot drift. The residual is within its bound, the same in the last pair as in the
   // second, and nonzero where it must be: flash on the LCD with white full frames carries the unreachable targets'
-  // shortfalls, the Nyquist checkerboard its clipped overshoot; the 4x4 texture never leaves [0, 1].
+  // shortfalls, the Nyquist checkerboard its clipped overshoot; the 4x4 texture never leaves [0, 1]. And memory is
+  // flat: the resident set, sampled every 1000 frames after a warm-up of 1000, never exceeds the warm-up's by more
+  // than kGrowthBoundKb (a leak of 10 bytes per frame would pass it by the end of the run).
   constexpr std::int64_t kFrames = 100000;
+  constexpr std::int64_t kWarmup = 1000, kSampleEvery = 1000, kGrowthBoundKb = 1024;
   const SoakCase& c = GetParam();
   trm::cli::PipelineOptions options;
   options.scene = c.scene;
@@ -100,6 +127,7 @@ TEST_P(StillSoak, FixedPointDecoderKeepsTheResidualBoundedAndTheOutputPeriodic) 
   std::vector<std::vector<std::uint16_t>> last_two(2);
   std::int64_t views = 0, mismatches = 0;
   double residual_second_pair = -1.0, residual_max = 0.0, residual_last_pair = -1.0;
+  std::int64_t warm_kb = -1, peak_after_warmup_kb = -1;
   trm::cli::run_pipeline(options, [&](const trm::cli::DecodedView& view) {
     const cv::Mat& codes = view.decoded->drive_codes;
     ASSERT_TRUE(codes.isContinuous());
@@ -113,6 +141,10 @@ TEST_P(StillSoak, FixedPointDecoderKeepsTheResidualBoundedAndTheOutputPeriodic) 
     residual_max = std::max(residual_max, residual);
     if (t == 4) residual_second_pair = residual;
     if (t == kFrames - 2) residual_last_pair = residual;
+    if (t == kWarmup) warm_kb = resident_kb();
+    if (t > kWarmup && (t % kSampleEvery == 0 || t == kFrames - 1)) {
+      peak_after_warmup_kb = std::max(peak_after_warmup_kb, resident_kb());
+    }
     ++views;
   });
   EXPECT_EQ(views, kFrames);
@@ -120,8 +152,15 @@ TEST_P(StillSoak, FixedPointDecoderKeepsTheResidualBoundedAndTheOutputPeriodic) 
   EXPECT_EQ(residual_max > 0.0, c.clips) << c.scene << " max |rho| " << residual_max;
   EXPECT_LE(residual_max, c.residual_bound) << c.scene;
   EXPECT_EQ(residual_last_pair, residual_second_pair) << c.scene;
+  ASSERT_GT(warm_kb, 0) << "/proc/self/statm unreadable";
+  if (kResidentSetMeaningful) {
+    EXPECT_LE(peak_after_warmup_kb - warm_kb, kGrowthBoundKb)
+        << c.scene << ": resident " << warm_kb << " kB at frame " << kWarmup << ", up to " << peak_after_warmup_kb
+        << " kB after";
+  }
   std::cout << c.scene << " on " << c.panel << ": " << kFrames << " frames, max |rho| " << residual_max
-            << ", output periodic\n";
+            << ", output periodic, resident set " << warm_kb << " kB at frame " << kWarmup << ", at most "
+            << peak_after_warmup_kb << " kB after\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(FlashStaticChecker, StillSoak,

@@ -220,6 +220,23 @@ TEST(Cli, RunWritesReportAndPreviews) {
   EXPECT_EQ(report["parameters"]["reduced_size"][0], 24);
   // Pixel ratio over whole pairs: (W H + w h) / (2 W H) = (48*40 + 24*20) / (2*48*40) = 0.625.
   EXPECT_DOUBLE_EQ(report["summary"]["pixel_ratio"].get<double>(), 0.625);
+  // The skips' traffic saved, from the run's own counters at the default formats (residual 30 bits, 8-bit link and
+  // drive, x_{t-1} sQ3.28): every residual line 3 * 48 * 30 bits, every static line two d_{t-1} rows of 3 * 24 * 8
+  // bits, and on the OLED every view's LCD stores, 3 * 48 * 40 samples * (8 + 2 * 31) bits.
+  const auto& events = report["summary"]["fixed_point_events"];
+  const auto& saved = events["traffic_saved_bytes"];
+  EXPECT_DOUBLE_EQ(saved["residual_write"].get<double>(),
+                   events["skipped"]["residual_write_lines"].get<double>() * 3 * 48 * 30 / 8);
+  EXPECT_DOUBLE_EQ(saved["residual_read"].get<double>(),
+                   events["skipped"]["residual_read_lines"].get<double>() * 3 * 48 * 30 / 8);
+  EXPECT_DOUBLE_EQ(saved["previous_low_read"].get<double>(),
+                   events["skipped"]["motion_test_lines"].get<double>() * 2 * 3 * 24 * 8 / 8);
+  EXPECT_DOUBLE_EQ(saved["lcd_stores"].get<double>(), 4.0 * 3 * 48 * 40 * 70 / 8);
+  EXPECT_DOUBLE_EQ(saved["total"].get<double>(), saved["residual_write"].get<double>() +
+                                                     saved["residual_read"].get<double>() +
+                                                     saved["previous_low_read"].get<double>() +
+                                                     saved["lcd_stores"].get<double>());
+  EXPECT_NE(r.output.find("off-chip traffic saved per view"), std::string::npos) << r.output;
   for (const char* name : {"pair_sent_full.png", "pair_sent_reduced.png", "pair_shown_beta.png",
                            "pair_shown_alpha.png", "pair_perceived.png", "pair_full_rate_reference.png"}) {
     EXPECT_TRUE(fs::exists(tmp.path() / "out" / name)) << name;

@@ -137,18 +137,6 @@ Stimulus scene_stimulus(const AnalyzeOptions& options, const std::string& scene,
   return s;
 }
 
-// The steady light (luma) the scan line's drive codes hold on the panel: what PanelLight integrates over a frame.
-cv::Mat steady_luma_line(const Panel& panel, int output_bits, const cv::Mat& drive_codes, int line) {
-  const double top = std::ldexp(1.0, output_bits) - 1.0;
-  cv::Mat rgb(1, drive_codes.cols, CV_64FC3);
-  const auto* code = drive_codes.ptr<cv::Vec3w>(line);
-  auto* out = rgb.ptr<cv::Vec3d>(0);
-  for (int x = 0; x < drive_codes.cols; ++x) {
-    for (int c = 0; c < 3; ++c) out[x][c] = steady_level(panel, code[x][c] / top, c);
-  }
-  return luma(rgb);
-}
-
 // The analysed line's x-t levels (one row per frame) `method` drives for the stimulus, through the method's real
 // GPU side and headset side (trm: TrmEncoder and the double-precision ReferenceDecoder).
 cv::Mat driven_levels(const Stimulus& stimulus, const PipelineOptions& base, const std::string& method,
@@ -174,7 +162,7 @@ cv::Mat driven_levels(const Stimulus& stimulus, const PipelineOptions& base, con
     } else {
       shown = display->show_unsent(unsent_slot(t, 0, frame.size(), run.encoder));
     }
-    rows.push_back(steady_luma_line(run.panel, run.output_bits, shown.drive_codes, stimulus.line));
+    rows.push_back(luma(steady_levels(run.panel, run.output_bits, shown.drive_codes.row(stimulus.line))));
   }
   cv::Mat levels;
   cv::vconcat(rows, levels);
@@ -240,7 +228,7 @@ cv::Mat cycle_levels(const Stimulus& stimulus, const PipelineOptions& base, doub
         }
       }
     }
-    rows.push_back(steady_luma_line(panel, base.output_bits, drive_codes, stimulus.line));
+    rows.push_back(luma(steady_levels(panel, base.output_bits, drive_codes.row(stimulus.line))));
   }
   cv::Mat levels;
   cv::vconcat(rows, levels);

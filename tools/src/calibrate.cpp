@@ -192,6 +192,7 @@ std::vector<PairReading> measure_pairs(const CalibrationOptions& options) {
   PanelLightConfig config;
   config.refresh_hz = options.refresh_hz;
   config.lc_response = options.lc;
+  config.overdrive = options.overdrive;
   const PanelLight light(config);
   const double period = light.frame_period_s();
   // Whole pairs of frames, so that the window holds as many v_t as v_{t−1} frames.

@@ -23,6 +23,7 @@ struct CalibrationOptions {
   std::uint64_t seed = 1;     // of the noise
   double native_gamma = 2.2;  // the simulated panel's held light v^γ
   LcResponseParams lc;        // the simulated liquid crystal
+  bool overdrive = false;     // the simulated panel overdrives it (PanelLightConfig::overdrive); so does the preset
   // Throws std::invalid_argument naming the option and its range.
   void validate() const;
 };

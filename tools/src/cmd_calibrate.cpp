@@ -62,8 +62,9 @@ void register_calibrate(CLI::App& app, Action& action) {
   cmd->add_option("--tau-off", options->lc.tau_off_s, "LC fall (elastic) time constant in s")->capture_default_str();
   cmd->add_option("--drive-ratio", options->lc.drive_ratio, "LC V_max / V_th (rise tau_off / ((V/V_th)^2 - 1))")
       ->capture_default_str();
-  cmd->add_option("--overdrive", options->lc.overdrive_grid, "Overdrive LUT size N (N x N; 0: none)")
-      ->capture_default_str();
+  cmd->add_flag("--overdrive", options->overdrive,
+               "The panel overdrives its LC (each frame reaches its level where the drive range allows); the "
+               "written preset says so too");
   cmd->add_option("--out,-o", *out, "Output directory (written whole or not at all)")->capture_default_str();
   cmd->callback([options, out, &action] {
     action = [options, out] {
@@ -75,6 +76,7 @@ void register_calibrate(CLI::App& app, Action& action) {
       panel.kind = PanelKind::Lcd;
       panel.name = "calibrated";
       panel.lcd = fit.panel;
+      panel.lcd.overdrive = options->overdrive;
       nlohmann::ordered_json preset;
       to_json(preset, panel);
       dir.write_text("panel.json", preset.dump(2) + "\n");

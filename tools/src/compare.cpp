@@ -99,7 +99,7 @@ class MethodMeter {
       }
     }
     if (slot.eye == 0) {
-      levels_.push_back(steady_luma_row(shown.drive_codes));
+      levels_.push_back(luma(steady_levels(panel_, output_bits_, shown.drive_codes.row(scan_line_))));
       if (profile_.empty()) profile_ = luma(view.linear_full->row(scan_line_));
     }
     eye.t = slot.index;
@@ -136,17 +136,6 @@ class MethodMeter {
     std::int64_t t = -2;
     cv::Mat luma, reference_luma, display, reference_display;
   };
-  // The light the scan line's drive codes hold on the panel (luma): what PanelLight integrates over a frame.
-  cv::Mat steady_luma_row(const cv::Mat& drive_codes) const {
-    const double top = std::ldexp(1.0, output_bits_) - 1.0;
-    cv::Mat rgb(1, drive_codes.cols, CV_64FC3);
-    const auto* code = drive_codes.ptr<cv::Vec3w>(scan_line_);
-    auto* out = rgb.ptr<cv::Vec3d>(0);
-    for (int x = 0; x < drive_codes.cols; ++x) {
-      for (int c = 0; c < 3; ++c) out[x][c] = steady_level(panel_, code[x][c] / top, c);
-    }
-    return luma(rgb);
-  }
   static cv::Mat stacked(const std::vector<cv::Mat>& rows) {
     cv::Mat out;
     if (!rows.empty()) cv::vconcat(rows, out);

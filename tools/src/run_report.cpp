@@ -36,6 +36,16 @@ Json events_json(const FixedStageCounts& c) {
 
 Json json_number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
+// The off-chip traffic the skips saved, in bytes (skip_traffic_saved).
+Json traffic_json(const FixedSkipTraffic& t) {
+  const auto bytes = [](std::int64_t bits) { return static_cast<double>(bits) / 8.0; };
+  return {{"residual_write", bytes(t.residual_write_bits)},
+          {"residual_read", bytes(t.residual_read_bits)},
+          {"previous_low_read", bytes(t.previous_low_read_bits)},
+          {"lcd_stores", bytes(t.lcd_store_bits)},
+          {"total", bytes(t.total_bits())}};
+}
+
 }  // namespace
 
 cv::Mat preview_8bit(const cv::Mat& linear_rgb) {
@@ -120,6 +130,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
     if (meta.parity == Parity::Full) skip_lines_full_ += meta.full_height;
     skip_lines_all_ += meta.full_height;
     have_fixed_counts_ = true;
+    ++fixed_views_;
   }
   if (view.reference) {
     const CodeAgreement agreement = compare_codes(d.drive_codes, view.reference->drive_codes);
@@ -215,6 +226,7 @@ Json RunRecorder::report(double wall_seconds) const {
   }
   if (have_fixed_counts_) {
     s["fixed_point_events"] = events_json(fixed_totals_);
+    s["fixed_point_events"]["traffic_saved_bytes"] = traffic_json(skip_traffic());
   }
   s["mean_seconds"] = {{"render", n > 0 ? sum_render_ / n : 0.0},
                        {"encode", n > 0 ? sum_encode_ / n : 0.0},
@@ -278,12 +290,29 @@ std::string RunRecorder::summary_table() const {
             fmt(", residual write %.1f %%", share(fixed_totals_.residual_write_lines_skipped, skip_lines_full_)) +
             fmt(", grey (one channel) %.1f %%", share(fixed_totals_.grey_lines, skip_lines_all_)));
   }
+  if (have_fixed_counts_) {
+    const FixedSkipTraffic t = skip_traffic();
+    const double per_view = 1.0 / (8.0 * 1024.0 * static_cast<double>(fixed_views_));
+    if (t.total_bits() > 0) {
+      row("off-chip traffic saved per view",
+          fmt("%.1f kB", static_cast<double>(t.total_bits()) * per_view) +
+              fmt(" (residual write %.1f", static_cast<double>(t.residual_write_bits) * per_view) +
+              fmt(", read %.1f", static_cast<double>(t.residual_read_bits) * per_view) +
+              fmt(", d_{t-1} read %.1f", static_cast<double>(t.previous_low_read_bits) * per_view) +
+              fmt(", LCD stores %.1f)", static_cast<double>(t.lcd_store_bits) * per_view));
+    }
+  }
   if (have_fixed_counts_ && fixed_totals_.residual_saturated > 0) {
     row("residual store saturations", std::to_string(fixed_totals_.residual_saturated) + " samples");
   }
   row("encode / decode per view", fmt("%.1f ms", 1e3 * s["mean_seconds"]["encode"].get<double>()) + " / " +
                                       fmt("%.1f ms", 1e3 * s["mean_seconds"]["decode"].get<double>()));
   return out.str();
+}
+
+FixedSkipTraffic RunRecorder::skip_traffic() const {
+  return skip_traffic_saved(fixed_config_of(options_), cv::Size(full_width_, full_height_), fixed_totals_,
+                            fixed_views_);
 }
 
 Progress::Progress(std::int64_t total) : total_(total), start_(now_seconds()), tty_(isatty(STDERR_FILENO) != 0) {}

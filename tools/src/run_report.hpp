@@ -58,6 +58,9 @@ class RunRecorder {
   int full_height() const { return full_height_; }
 
  private:
+  // What the skips of the views so far saved in off-chip traffic (only with fixed-point counters).
+  FixedSkipTraffic skip_traffic() const;
+
   PipelineOptions options_;
   Panel panel_;
   PairTracker pairs_tracker_;
@@ -80,6 +83,7 @@ class RunRecorder {
   std::int64_t skip_lines_full_ = 0;     // output lines of full views (residual-write skips)
   std::int64_t skip_lines_all_ = 0;      // output lines of every view (grey skips)
   bool have_fixed_counts_ = false;
+  std::int64_t fixed_views_ = 0;  // views with fixed-point counters (fixed_totals_ sums them)
   double sum_render_ = 0;
   double sum_pixels_rendered_ = 0, sum_pixels_sent_ = 0, sum_pixels_full_ = 0;
 };

@@ -13,26 +13,22 @@ namespace trm::cli {
 
 namespace {
 
-// The steady light the drive codes hold on the panel: what PanelLight integrates over a frame.
-cv::Mat steady_levels(const cv::Mat& drive_codes, const Panel& panel, int output_bits) {
-  const double top = std::ldexp(1.0, output_bits) - 1.0;
-  cv::Mat levels(drive_codes.size(), CV_64FC3);
-  for (int y = 0; y < drive_codes.rows; ++y) {
-    const auto* code = drive_codes.ptr<cv::Vec3w>(y);
-    auto* out = levels.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < drive_codes.cols; ++x) {
-      for (int c = 0; c < 3; ++c) out[x][c] = steady_level(panel, code[x][c] / top, c);
-    }
-  }
-  return levels;
-}
-
-// The liquid crystal's state after showing `levels` for a frame from `state` (in place).
-void advance_state(cv::Mat& state, const cv::Mat& levels, const PanelLight& light) {
+// The liquid crystal's state after showing `levels` for a frame from (`state`, `rate`), in place; `rate` is the
+// second-order LC's (empty for the first-order models).
+void advance_state(cv::Mat& state, cv::Mat& rate, const cv::Mat& levels, const PanelLight& light) {
   auto* s = state.ptr<double>(0);
+  auto* r = rate.empty() ? nullptr : rate.ptr<double>(0);
   const auto* l = levels.ptr<double>(0);
   const std::size_t samples = levels.total() * static_cast<std::size_t>(levels.channels());
-  for (std::size_t i = 0; i < samples; ++i) s[i] = light.end_state(s[i], l[i]);
+  for (std::size_t i = 0; i < samples; ++i) {
+    if (r) {
+      const LcMotion next = light.end_state(LcMotion{s[i], r[i]}, l[i]);
+      s[i] = next.level;
+      r[i] = next.rate_per_s;
+    } else {
+      s[i] = light.end_state(s[i], l[i]);
+    }
+  }
 }
 
 }  // namespace
@@ -56,25 +52,28 @@ PerceivedSequence perceive(const std::vector<ShownFrame>& frames, const EyeSetup
   std::vector<cv::Mat> scan_line;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     if (i > 0 && frames[i].t <= frames[i - 1].t) throw std::invalid_argument("perceive: `frames` not in time order");
-    levels.push_back(steady_levels(frames[i].drive_codes, setup.panel, setup.output_bits));
+    levels.push_back(steady_levels(setup.panel, setup.output_bits, frames[i].drive_codes));
     scan_line.push_back(luma(levels.back().row(setup.scan_line)));
   }
   const double period = setup.light.frame_period_s();
   RetinaOptions retina;
   retina.substeps = substeps;
   // The LC state each pair starts from: the frames before it shown in turn (settled at the first frame).
-  cv::Mat state;
+  // (A second-order LC starts at rest and carries its rate along.)
+  cv::Mat state, rate;
   if (setup.light.has_lc_state()) state = levels.front().clone();
+  if (setup.light.lc_second_order()) rate = cv::Mat::zeros(levels.front().size(), levels.front().type());
   std::size_t advanced = 0;
   for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
     if (frames[i].t % 2 != 0 || frames[i + 1].t != frames[i].t + 1) continue;
     if (!state.empty()) {
-      for (; advanced < i; ++advanced) advance_state(state, levels[advanced], setup.light);
+      for (; advanced < i; ++advanced) advance_state(state, rate, levels[advanced], setup.light);
     }
     // The retinal grid lies on the screen's at the pair's start, for every sequence alike.
     retina.origin_s = static_cast<double>(frames[i].t) * period;
     seen.pairs.push_back(retinal_image({levels[i], levels[i + 1]}, setup.light, setup.viewer,
-                                       setup.eye_velocity_deg_s, retina, advanced > 0 ? state : cv::Mat()));
+                                       setup.eye_velocity_deg_s, retina, advanced > 0 ? state : cv::Mat(),
+                                       advanced > 0 ? rate : cv::Mat()));
   }
   cv::Mat lines;
   cv::vconcat(scan_line, lines);

@@ -253,6 +253,31 @@ struct FixedStreamingReport {
   std::string concealment;
 };
 
+// The off-chip traffic the DESIGN §7 skips avoided (bits), from the skip counters of the views decoded and the
+// widths of the frame stores FixedStreamingReport lists (the one home of that arithmetic):
+// * residual write: a full-frame line whose rho is all zero is not written, 3 W samples of the residual format;
+// * residual read: a reduced-frame line with no residual is not read, the same;
+// * d_{t-1} read: a static line (motion test skipped) does not read the two d_{t-1} rows U blends for L_{t-1},
+//   2 × 3 w link codes (the model keeps no line buffer of d_{t-1}; the comparator's one read per row as it enters
+//   the U buffer is made either way);
+// * LCD stores (OLED): per sample of every view an LCD reads v_{t-1} (output bits) and reads and writes x_{t-1}
+//   (sQ3.F); its v_t write is the OLED's held-output store's too, which the OLED keeps.
+// The chroma skip (grey lines) saves arithmetic, not traffic: a grey line's copied channels are written whole to the
+// line buffers and stores, so it has no entry here (its saving is the benchmark's time, README "Performance").
+struct FixedSkipTraffic {
+  std::int64_t residual_write_bits = 0;
+  std::int64_t residual_read_bits = 0;
+  std::int64_t previous_low_read_bits = 0;
+  std::int64_t lcd_store_bits = 0;
+  std::int64_t total_bits() const {
+    return residual_write_bits + residual_read_bits + previous_low_read_bits + lcd_store_bits;
+  }
+};
+// `counts` summed over `views` decoded views of size `full` (w = reduced_size(W, r) of config.decoder.link). Throws
+// std::invalid_argument naming `full` (below 1x1) or `views` (< 0).
+FixedSkipTraffic skip_traffic_saved(const FixedDecoderConfig& config, cv::Size full, const FixedStageCounts& counts,
+                                    std::int64_t views);
+
 // The integer planes of every stage of one decoded frame, for test vectors (FixedFrameDecoder::decode with taps),
 // by Stage (the stages up to Drive; the LCD and unclamped-alpha stages are not tapped). Values are the raw integers
 // of the stage's format, row-major with channels interleaved (R G B) where channels == 3; motion contrast and weight

@@ -1,5 +1,5 @@
 // The liquid crystal's level-dependent response (DESIGN §7 "LC response", paper Sec. 2.2 and 4.4): how fast a pixel's
-// optical state x follows the level p the panel drives, and the overdrive LUT the panel applies before the LC.
+// optical state x follows the level p the panel drives, and the overdrive that inverts it.
 //
 //   dx/dt = (p − x) / τ(x, p),   τ = τ_on(p) while rising (p > x), τ_off while falling (p <= x)
 //
@@ -14,12 +14,14 @@
 // stable for any τ and step (no time-stepping of the ODE). τ_on grows without bound as p → 0 (V → V_th): rising to a
 // dark grey is the slowest transition, as on real panels, while its amplitude goes to 0 with it.
 //
-// Overdrive: the panel looks up, for the state x the last frame left and the wanted level L, the drive p that ends
-// the frame at L (one exponential segment of period T), tabulated on an N × N grid over [0, 1]² and interpolated
-// bilinearly. Where even p = 1 (or 0) cannot reach L within a frame the entry is clamped to the drive range.
+// Overdrive (PanelLightConfig::overdrive): for the state x the last frame left and the wanted level L, the panel
+// drives the p that ends the frame at L, the inverse of one exponential segment of period T. Falling (L <= x) has
+// τ_off whatever p is, so p = x + (L − x) / (1 − e^{−T/τ_off}) in closed form; rising, τ_on depends on p and the end
+// state p + (x − p) e^{−T/τ_on(p)} (increasing in p) is solved by safeguarded Newton to a few ulps. Where even p = 1
+// (or 0) cannot reach L within a frame, p is clamped to the drive range, the end state nearest L. This is the ideal
+// panel LUT (previous level, target level) → drive, exact at every entry: a real panel's 17 × 17 or 33 × 33 table
+// interpolates it.
 #pragma once
-
-#include <vector>
 
 namespace trm {
 
@@ -31,7 +33,6 @@ struct LcResponseParams {
   double tau_off_s = 0.002;         // > 0 and finite: falling (elastic) time constant
   double drive_ratio = 3.0;         // V_max / V_th, > 1 and finite
   double drive_gamma = 2.2;         // γ_d: level p ↔ drive code p^(1/γ_d), in [0.5, 4]
-  int overdrive_grid = 0;           // N of the N × N overdrive LUT; 0: no overdrive, else >= 2 and <= 4096
 };
 
 // One frame's segment of the ODE: the level the LC relaxes toward and its time constant.
@@ -43,7 +44,7 @@ struct LcSegment {
 class LcResponse {
  public:
   // Throws std::invalid_argument naming the field and its range (see LcResponseParams) or `frame_period_s`
-  // (finite and > 0: the overdrive LUT solves for one frame).
+  // (finite and > 0: the overdrive solves for one frame).
   LcResponse(const LcResponseParams& params, double frame_period_s);
 
   const LcResponseParams& params() const { return params_; }
@@ -53,16 +54,15 @@ class LcResponse {
   double tau_s(double state, double drive) const { return drive > state ? rise_tau_s(drive) : params_.tau_off_s; }
   // x after holding drive p for `seconds` from x: p + (x − p) e^{−t/τ(x, p)}, exact for constant drive.
   double advance(double state, double drive, double seconds) const;
-  // The drive the panel applies for wanted level L after state x (the LUT, or L without overdrive).
-  double drive_for(double state, double level) const;
-  LcSegment segment(double state, double level) const;
-  // The drive that ends one frame at L from x, solved (bisection, to 1e-15) without the LUT: what the LUT tabulates.
-  double exact_overdrive(double state, double level) const;
+  // The segment that drives p from x.
+  LcSegment segment(double state, double drive) const { return {drive, tau_s(state, drive)}; }
+  // The overdrive: the drive in [0, 1] whose frame from x ends at L, or the clamped one nearest L (x, L in [0, 1]).
+  double overdrive(double state, double level) const;
 
  private:
   LcResponseParams params_;
   double period_ = 0.0;
-  std::vector<double> lut_;  // [state index][level index], N × N
+  double fall_reach_ = 0.0;  // 1 − e^{−T/τ_off}: the share of a falling step one frame delivers
 };
 
 }  // namespace trm

@@ -56,6 +56,10 @@ class LcSecondOrder {
   LcMotion advance(const LcMotion& start, double drive, double seconds) const;
   // advance() over one frame period, from the propagator computed at construction.
   LcMotion end_of_frame(const LcMotion& start, double drive) const;
+  // The overdrive: the drive in [0, 1] whose frame from `start` ends at `level`, or the clamped one nearest it. The
+  // end level p (1 − Φ₀₀) + Φ₀₀ x0 + Φ₀₁ τ x0' (Φ = e^{BT/τ}) is affine in p with slope 1 − Φ₀₀ > 0, so the inverse
+  // is closed form and the clamp is the best the drive range allows.
+  double overdrive(const LcMotion& start, double level) const;
   // The weights of ∫_{t0}^{t1} x dt, 0 <= t0 <= t1 (throws std::invalid_argument naming `t0` or `t1`).
   LcMotionWeights weights(double t0, double t1) const;
   double integral(const LcMotion& start, double drive, double t0, double t1) const;

@@ -51,6 +51,9 @@ struct LcdPanel {
   // The liquid crystal of the eye model's light (panel_light.hpp): unset, the level-dependent first-order response;
   // set, the second-order system (damping_ratio >= kMinPanelDampingRatio). The drive (Eq. 7) does not depend on it.
   std::optional<LcSecondOrderParams> lc_second_order;
+  // The panel overdrives its liquid crystal (panel_light.hpp, PanelLightConfig::overdrive): the eye model's light
+  // reaches each frame's level within the frame where the drive range allows. The drive (Eq. 7) does not depend on it.
+  bool overdrive = false;
 
   double merge(double v_t, double v_prev) const;
   // Solves M(v, v_prev) = m for v in [0, 1] with the stable quadratic root form (linear solve when
@@ -150,12 +153,13 @@ Panel parse_panel(const std::string& spec);
 
 // The panel as JSON, every parameter of its kind: {"kind": "oled", "name", "gamma": [R, G, B], "duty"} or
 // {"kind": "lcd", "name", "p1", "p2", "p3", "p4", "gamma"}, and with a second-order liquid crystal
-// "lc_second_order": {"tau_s", "damping_ratio"} (absent without one). The one writer and the one reader of a panel, for both
+// "lc_second_order": {"tau_s", "damping_ratio"} (absent without one), with overdrive "overdrive": true (absent
+// without). The one writer and the one reader of a panel, for both
 // JSON flavours the reports use (one body each).
 void to_json(nlohmann::json& out, const Panel& panel);
 void to_json(nlohmann::ordered_json& out, const Panel& panel);
-// Throws std::invalid_argument "panel JSON: ..." for a missing or mistyped field, an unknown kind or a panel that
-// breaks validate_panel's rules.
+// Throws std::invalid_argument "panel JSON: ..." for a missing or mistyped field (an "overdrive" that is not a
+// boolean), an unknown kind or a panel that breaks validate_panel's rules.
 void from_json(const nlohmann::json& in, Panel& panel);
 void from_json(const nlohmann::ordered_json& in, Panel& panel);
 

@@ -19,13 +19,20 @@
 //
 // The liquid crystal relaxes toward L for the whole frame, lit or not, and a frame ends at end_state(s0, L), where
 // the next frame starts. τ is either one constant (lc_tau_s) or, for LCD panels, the level-dependent response of
-// lc_response.hpp (rise τ_on(p) faster at higher drive, fall τ_off, optional overdrive): then each frame's segment
-// relaxes toward the drive p the panel applies (L, or the overdriven level) with τ(s0, p), per pixel. Or the LC is
+// lc_response.hpp (rise τ_on(p) faster at higher drive, fall τ_off): then each frame's segment relaxes toward the
+// drive p the panel applies with τ(s0, p), per pixel. Or the LC is
 // the second-order system of lc_second_order.hpp (an LCD preset's "lc_second_order"): its state is the level and
 // its rate (LcMotion), and the light of a part of a frame is linear in L, s0 and the rate s0' with weights shared by
 // every pixel. Every value is the closed form (the exponential or matrix-exponential update, not a time step of the
 // ODE), so it is exact and stable for any τ >= 0: τ far below T reaches L without overshoot, τ far above T barely
 // moves.
+//
+// Overdrive (an LCD preset's "overdrive": true): the panel drives, instead of L, the level p = drive(s0, L) whose
+// frame ends at L, the inverse of its own LC model's exact one-frame response (constant τ and the falling first-order
+// segment: s0 + (L − s0) / (1 − e^{−T/τ}); the rising one: lc_response.hpp; second order: lc_second_order.hpp, from
+// the level and the rate), clamped to the drive range [0, 1] where no drive reaches L within the frame. The panel
+// knows its LC's state because it computes it from the drives it applied (a frame memory of the previous level, as
+// panels keep for their overdrive LUT). Every function below that takes the wanted level L applies it.
 //
 // Rolling scan-out: row y of H starts its frames y / H · T after row 0 (the scan reaches it then); global scan-out
 // starts every row together. Times passed to level_at and integral are since the row's own frame start.
@@ -53,6 +60,8 @@ struct PanelLightConfig {
   std::optional<LcResponseParams> lc_response = std::nullopt;
   // The second-order LC; set, it replaces both (lc_tau_s must be 0 and lc_response unset).
   std::optional<LcSecondOrderParams> lc_second_order = std::nullopt;
+  // The panel overdrives its LC (drive()); needs an LC with state (lc_tau_s > 0, lc_response or lc_second_order).
+  bool overdrive = false;
 };
 
 // Low persistence on the Vive (paper Sec. 2.2, Fig. 2c, measured with a 9 kHz sensor: "the display remains black for
@@ -106,11 +115,15 @@ class PanelLight {
   // The second-order LC: the state is an LcMotion, and the LcMotion overloads below are the ones to use (the scalar
   // ones take the state at rest, and end_state(double, double) throws std::logic_error, as it would drop the rate).
   const std::optional<LcSecondOrder>& lc_second_order() const { return second_order_; }
-  // The frame's segment from state s0 for wanted level L: the drive the LC relaxes toward and τ (constant τ: L, τ).
+  // The level the panel drives for wanted level L after state s0: L, or with overdrive the one that ends the frame at
+  // L where [0, 1] allows (levels outside [0, 1] are driven as they are). The scalar form takes s0 at rest.
+  double drive(const LcMotion& previous_state, double level) const;
+  double drive(double previous_state, double level) const { return drive(LcMotion{previous_state, 0.0}, level); }
+  // The frame's segment from state s0 for wanted level L: the drive the LC relaxes toward and τ (constant τ: τ).
   LcSegment segment(double previous_state, double level) const;
 
-  // light(t) for t in [0, T] since the frame start, after state s0 (`previous_state`), driving `level` (through
-  // segment(): with overdrive the LC relaxes toward the overdriven level).
+  // light(t) for t in [0, T] since the frame start, after state s0 (`previous_state`), for wanted level `level` (the
+  // LC relaxes toward drive(s0, level)).
   double level_at(double t, double previous_state, double level) const;
   double level_at(double t, const LcMotion& previous_state, double level) const;
   // ∫_{t0}^{t1} light dt in closed form, 0 <= t0 <= t1 <= T (throws std::invalid_argument naming `t0` or `t1`):
@@ -132,6 +145,7 @@ class PanelLight {
   double window_begin_ = 0.0;
   double window_end_ = 0.0;
   double decay_ = 0.0;  // e^{−T/τ}
+  double reach_ = 0.0;  // 1 − e^{−T/τ}
   std::optional<LcResponse> response_;
   std::optional<LcSecondOrder> second_order_;
 
@@ -141,13 +155,16 @@ class PanelLight {
 
 // The light of `panel` at `refresh_hz`: an OLED emits for panel.oled.duty of the frame from its start with no LC
 // response; an LCD holds (or strobes) with the level-dependent LC response options.lc_response, or with the
-// second-order LC when its preset has one (panel.lcd.lc_second_order, which then replaces options.lc_response). Throws
-// std::invalid_argument naming the argument.
+// second-order LC when its preset has one (panel.lcd.lc_second_order, which then replaces options.lc_response), and
+// overdrives it when the preset says so (panel.lcd.overdrive). Throws std::invalid_argument naming the argument.
 PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOptions& options = {});
 
 // The steady level drive v holds on `panel` (channel c): OLED v^gamma_c, LCD M(v, v)^gamma. What a frame's drive
 // gives this model as L; for an OLED it is also the frame's emitted_linear (the LCD's emitted_linear already averages
 // the LC transition of the merge model, so it must not be fed again through τ).
 double steady_level(const Panel& panel, double v, int channel);
+// steady_level of every sample of drive codes (CV_16UC3 at `output_bits`, code / (2^bits − 1)): CV_64FC3, the levels
+// L a decoded frame gives this model. Throws std::invalid_argument naming `drive_codes` for another type.
+cv::Mat steady_levels(const Panel& panel, int output_bits, const cv::Mat& drive_codes);
 
 }  // namespace trm

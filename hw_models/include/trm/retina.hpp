@@ -96,9 +96,11 @@ cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer
                     const RetinaOptions& options = {}, const cv::Mat& previous = {});
 
 // The retinal image (time average) of whole frames, each row y delayed by its scan-out: same size and type as the
-// frames. `previous`: the LC state before frame 0, empty for settled. Throws std::invalid_argument naming the argument.
+// frames. `previous`: the LC state before frame 0, empty for settled; `previous_rate`: a second-order LC's rate
+// (1/s) there, empty for at rest (ignored by first-order models). Throws std::invalid_argument naming the argument.
 cv::Mat retinal_image(const std::vector<cv::Mat>& frames, const PanelLight& light, const Viewer& viewer,
-                      double eye_velocity_deg_s, const RetinaOptions& options = {}, const cv::Mat& previous = {});
+                      double eye_velocity_deg_s, const RetinaOptions& options = {}, const cv::Mat& previous = {},
+                      const cv::Mat& previous_rate = {});
 
 // The x–t image of the scan line in a frame of reference moving at frame_velocity_deg_s (0: the physical image,
 // Fig. 12 column 1; the eye's velocity: the retinal image, column 2; the target's: the supplement's Fig. 1 right).
