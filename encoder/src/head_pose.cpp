@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace trm {
 
@@ -43,6 +44,29 @@ Eigen::Quaterniond interpolated_orientation(const Eigen::Quaterniond& previous, 
 
 double rotation_angle_deg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   return a.angularDistance(b) * 180.0 / std::numbers::pi;
+}
+
+HeadPath::HeadPath(std::vector<Eigen::Quaterniond> frame_orientations, double period_s)
+    : orientations_(std::move(frame_orientations)), period_s_(period_s) {
+  if (orientations_.empty()) throw std::invalid_argument("HeadPath: frame_orientations must hold at least one pose");
+  if (!(std::isfinite(period_s) && period_s > 0.0)) {
+    throw std::invalid_argument("HeadPath: period_s must be finite and > 0, got " + std::to_string(period_s));
+  }
+}
+
+Eigen::Quaterniond HeadPath::orientation_at(double t_s) const {
+  if (!std::isfinite(t_s)) throw std::invalid_argument("HeadPath: t_s must be finite");
+  const double frame = t_s / period_s_;
+  if (frame <= 0.0) return orientations_.front();
+  const auto last = static_cast<double>(orientations_.size() - 1);
+  if (frame >= last) return orientations_.back();
+  const double start = std::floor(frame);
+  const auto f = static_cast<std::size_t>(start);
+  return interpolated_orientation(orientations_[f], orientations_[f + 1], frame - start);
+}
+
+cv::Point2d HeadPath::fixated_pixel(cv::Point2d pixel, double t_s, const PinholeView& projection) const {
+  return reproject_pixel(pixel, orientations_.front(), orientation_at(t_s), projection);
 }
 
 namespace {

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "perception_checks.hpp"
 #include "trm/pursuit.hpp"
@@ -129,6 +131,30 @@ void mean_over_shifts(const double* src, Line line, double c0, double c1, double
   }
 }
 
+// Where the moving frame of reference (eye or target) stands at time t, in pixels from where it stood at t_origin:
+// at a constant velocity, or along a path sampled where the step asks.
+class FrameMotion {
+ public:
+  FrameMotion(double velocity_px_s, double origin_s) : velocity_px_s_(velocity_px_s), origin_s_(origin_s) {}
+  FrameMotion(const char* where, const std::function<double(double)>& path_px, double origin_s)
+      : where_(where), path_px_(&path_px), origin_s_(origin_s), origin_px_(at(origin_s)) {}
+
+  double shift(double t_s) const { return path_px_ ? at(t_s) - origin_px_ : velocity_px_s_ * (t_s - origin_s_); }
+
+ private:
+  double at(double t_s) const {
+    const double x = (*path_px_)(t_s);
+    if (!std::isfinite(x)) reject(where_, "gaze.path_px", "must give finite positions, got " + number_text(x));
+    return x;
+  }
+
+  const char* where_ = "";
+  const std::function<double(double)>* path_px_ = nullptr;
+  double velocity_px_s_ = 0.0;
+  double origin_s_ = 0.0;
+  double origin_px_ = 0.0;
+};
+
 // How a pass lays its sub-steps and where it writes them.
 enum class Steps {
   Lit,     // S steps over the lit window of each frame, all summed into out_rows[0] as a time average
@@ -138,8 +164,8 @@ enum class Steps {
 // One scan line through K frames: the panel light of each step (exact), shifted by the moving frame's position at
 // the step's middle.
 void line_pass(const std::vector<const double*>& frames, Line line, const double* previous,
-               const double* previous_rate, const PanelLight& light,
-               double velocity_px_s, double delay_s, double origin_s, int substeps, Steps steps,
+               const double* previous_rate, const PanelLight& light, const FrameMotion& motion, double delay_s,
+               int substeps, Steps steps,
                const std::vector<double*>& out_rows) {
   const double period = light.frame_period_s();
   const auto frame_count = static_cast<int>(frames.size());
@@ -170,7 +196,7 @@ void line_pass(const std::vector<const double*>& frames, Line line, const double
       const double t0 = begin + (end - begin) * k / substeps;
       const double t1 = k + 1 == substeps ? end : begin + (end - begin) * (k + 1) / substeps;
       const double middle = delay_s + f * period + (t0 + t1) / 2.0;
-      const double shift = velocity_px_s * (middle - origin_s);
+      const double shift = motion.shift(middle);
       double* dst = steps == Steps::Lit ? out_rows[0] : out_rows[static_cast<std::size_t>(f) * substeps + k];
       const double scale = steps == Steps::Lit ? 1.0 / (frame_count * period) : 1.0 / (t1 - t0);
       if (per_pixel) {
@@ -219,19 +245,21 @@ Line check_scan_line(const char* where, const cv::Mat& frames, const Viewer& vie
   return Line{frames.cols, frames.channels()};
 }
 
+// `path_px`: the moving frame's path, or null for the constant velocity_deg_s.
 cv::Mat scan_line_pass(const char* where, const cv::Mat& frames, const PanelLight& light, const Viewer& viewer,
-                       double velocity_deg_s, const char* velocity_name, const RetinaOptions& options,
-                       const cv::Mat& previous, Steps steps) {
+                       double velocity_deg_s, const std::function<double(double)>* path_px, const char* velocity_name,
+                       const RetinaOptions& options, const cv::Mat& previous, Steps steps) {
   const Line line = check_scan_line(where, frames, viewer, velocity_deg_s, velocity_name, options, previous);
+  const FrameMotion motion = path_px ? FrameMotion(where, *path_px, options.origin_s)
+                                     : FrameMotion(velocity_deg_s * viewer.pixels_per_degree, options.origin_s);
   std::vector<const double*> rows;
   for (int f = 0; f < frames.rows; ++f) rows.push_back(frames.ptr<double>(f));
   const int out_rows = steps == Steps::Lit ? 1 : frames.rows * options.substeps;
   cv::Mat out = cv::Mat::zeros(out_rows, frames.cols, frames.type());
   std::vector<double*> out_ptrs;
   for (int m = 0; m < out_rows; ++m) out_ptrs.push_back(out.ptr<double>(m));
-  line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(0), nullptr, light,
-            velocity_deg_s * viewer.pixels_per_degree, light.row_delay_s(options.row, options.rows), options.origin_s,
-            options.substeps, steps, out_ptrs);
+  line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(0), nullptr, light, motion,
+            light.row_delay_s(options.row, options.rows), options.substeps, steps, out_ptrs);
   return out;
 }
 
@@ -274,6 +302,12 @@ Gaze Gaze::perfect_pursuit(double target_velocity_deg_s) {
   return {target_velocity_deg_s, target_velocity_deg_s};
 }
 
+Gaze Gaze::following(std::function<double(double t_s)> path_px, double mean_velocity_deg_s) {
+  if (!path_px) reject("Gaze::following", "path_px", "must be a path (got none)");
+  require_finite("Gaze::following", "mean_velocity_deg_s", mean_velocity_deg_s);
+  return {mean_velocity_deg_s, mean_velocity_deg_s, std::move(path_px)};
+}
+
 int substeps_for_error(const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s, double max_error) {
   constexpr const char* kWhere = "substeps_for_error";
   require_positive(kWhere, "viewer.pixels_per_degree", viewer.pixels_per_degree);
@@ -291,20 +325,35 @@ int substeps_for_error(const PanelLight& light, const Viewer& viewer, double eye
 
 cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s,
                     const RetinaOptions& options, const cv::Mat& previous) {
-  return scan_line_pass("retinal_row", frames, light, viewer, eye_velocity_deg_s, "eye_velocity_deg_s", options,
-                        previous, Steps::Lit);
+  return scan_line_pass("retinal_row", frames, light, viewer, eye_velocity_deg_s, nullptr, "eye_velocity_deg_s",
+                        options, previous, Steps::Lit);
+}
+
+cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, const Gaze& gaze,
+                    const RetinaOptions& options, const cv::Mat& previous) {
+  return scan_line_pass("retinal_row", frames, light, viewer, gaze.eye_velocity_deg_s,
+                        gaze.path_px ? &gaze.path_px : nullptr, "gaze.eye_velocity_deg_s", options, previous,
+                        Steps::Lit);
 }
 
 cv::Mat retinal_xt(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, double frame_velocity_deg_s,
                    const RetinaOptions& options, const cv::Mat& previous) {
-  return scan_line_pass("retinal_xt", frames, light, viewer, frame_velocity_deg_s, "frame_velocity_deg_s", options,
-                        previous, Steps::Uniform);
+  return scan_line_pass("retinal_xt", frames, light, viewer, frame_velocity_deg_s, nullptr, "frame_velocity_deg_s",
+                        options, previous, Steps::Uniform);
+}
+
+cv::Mat retinal_xt(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, const Gaze& gaze,
+                   const RetinaOptions& options, const cv::Mat& previous) {
+  return scan_line_pass("retinal_xt", frames, light, viewer, gaze.eye_velocity_deg_s,
+                        gaze.path_px ? &gaze.path_px : nullptr, "gaze.eye_velocity_deg_s", options, previous,
+                        Steps::Uniform);
 }
 
 cv::Mat target_frame_xt(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, const Gaze& gaze,
                         const RetinaOptions& options, const cv::Mat& previous) {
   return scan_line_pass("target_frame_xt", frames, light, viewer, gaze.target_velocity_deg_s,
-                        "gaze.target_velocity_deg_s", options, previous, Steps::Uniform);
+                        gaze.path_px ? &gaze.path_px : nullptr, "gaze.target_velocity_deg_s", options, previous,
+                        Steps::Uniform);
 }
 
 double xt_samples_per_second(const PanelLight& light, int substeps) {
@@ -349,8 +398,9 @@ cv::Mat retinal_image(const std::vector<cv::Mat>& frames, const PanelLight& ligh
     for (int y = range.start; y < range.end; ++y) {
       for (std::size_t f = 0; f < frames.size(); ++f) rows[f] = frames[f].ptr<double>(y);
       line_pass(rows, line, previous.empty() ? nullptr : previous.ptr<double>(y),
-                previous_rate.empty() ? nullptr : previous_rate.ptr<double>(y), light, velocity_px_s,
-                light.row_delay_s(y, height), options.origin_s, options.substeps, Steps::Lit, {out.ptr<double>(y)});
+                previous_rate.empty() ? nullptr : previous_rate.ptr<double>(y), light,
+                FrameMotion(velocity_px_s, options.origin_s), light.row_delay_s(y, height), options.substeps,
+                Steps::Lit, {out.ptr<double>(y)});
     }
   });
   return out;

@@ -3,9 +3,14 @@
 // output agrees with the double reference as in the encoded space (DESIGN §6).
 #include "fixed_decoder_test_support.hpp"
 
+#include "trm/resample.hpp"
+#include "trm/transfer.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,41 +59,61 @@ TEST(FixedLinearSpace, StreamingMatchesFrameOnLcdOddSizesAndStereo) {
   }
 }
 
-// d_t = Q_b(enc(D(lin(E_t)))) exactly as the encoder computes it, code for code, on every scene and noise, for both
-// transfers and both link depths.
-TEST(FixedLinearSpace, ReducedFrameIsTheEncodersCodeForCode) {
+// d_t = Q_b(enc(D(lin(E_t)))) as the encoder computes it, code for code, on every scene and noise, for both transfers
+// and both link depths, except where the encoder's D lies closer to a code threshold than the decoder's D can resolve.
+// The decoder computes D on the uQ1.P grid (P = 32): lin(E) from a ROM, the horizontal and the vertical sums each
+// rounded to the grid, every one of the three within half an LSB, so a value within 1.5 LSB of a threshold T_k =
+// lin((k - 1/2) / (2^b - 1)) may land on either side of it. That is no exact tie (the encoder's tie tolerance is 1e-9
+// code) and both codes are within half a code and that distance of the exact value. Measured: one such code in this
+// whole sweep, headturn (48x32, r = 1/4, sRGB 8 bits, t = 2, reduced sample (8, 4), green): the
+// encoder's D = 0.026777882675417204 (45.500000045 codes, 4.9e-11 = 0.21 LSB above T_46 = 0.026777882626779784), the
+// decoder's D 0.35 LSB below it, so 45 against the encoder's 46. At P = 34 (T = 28) it agrees: the grid, not the taps.
+TEST(FixedLinearSpace, ReducedFrameIsTheEncodersCodeForCodeExceptWithinTheGridOfAThreshold) {
   std::vector<std::pair<std::string, std::vector<cv::Mat>>> sets;
-  for (const std::string& name : scene_names()) {
-    // headturn at 48x32, r = 1/4, 8 bits, t = 2 puts one reduced code where the fixed-point D rounds the other way
-    // than the double encoder (an open finding for the decoder's owners); every other scene holds code for code.
-    if (name != "headturn") sets.emplace_back(name, scene_images(name, 48, 32, 3));
-  }
+  for (const std::string& name : scene_names()) sets.emplace_back(name, scene_images(name, 48, 32, 3));
   sets.emplace_back("noise", noise_images(48, 32, 3, 17));
+  int near_threshold = 0;
   for (const auto& [name, images] : sets) {
     for (double r : {1.0, 0.75, 0.5, 0.4, 0.25}) {
       for (const int bits : {8, 10}) {
         EncoderConfig link = link_config(r, 0, false, bits, kLinear);
         link.transfer = bits == 8 ? Transfer::Srgb : Transfer::Gamma22;
-        FixedFrameDecoder decoder(fixed_config(link, "vive", bits));
+        const FixedDecoderConfig config = fixed_config(link, "vive", bits);
+        const double grid_lsb = std::ldexp(1.0, -config.linear_resample_frac_bits);
+        const double top = std::ldexp(1.0, bits) - 1.0;
+        FixedFrameDecoder decoder(config);
         for (const LinkFrame& frame : encode_sequence(images, link)) {
           if (frame.meta.parity != Parity::Full) continue;
           FixedStageTaps taps;
           decoder.decode(frame, taps);
-          const cv::Mat expected = reduce_codes(frame.codes, link).reshape(1);
+          const cv::Mat encoder_codes = reduce_codes(frame.codes, link);
+          const cv::Mat expected = encoder_codes.reshape(1);
+          // The encoder's D before its quantiser, in linear light.
+          const cv::Mat d_linear = downsample(to_linear(dequantise(frame.codes, bits), link.transfer),
+                                              encoder_codes.cols, encoder_codes.rows, link.effective_sigma())
+                                       .reshape(1);
           const std::vector<std::int64_t>& d = taps[Stage::Reduced].values;
           ASSERT_EQ(d.size(), expected.total());
-          int differing = 0;
           for (int y = 0; y < expected.rows; ++y) {
             for (int k = 0; k < expected.cols; ++k) {
-              differing += d[static_cast<std::size_t>(y) * static_cast<std::size_t>(expected.cols) +
-                             static_cast<std::size_t>(k)] != expected.at<std::uint16_t>(y, k);
+              const std::int64_t got = d[static_cast<std::size_t>(y) * static_cast<std::size_t>(expected.cols) +
+                                         static_cast<std::size_t>(k)];
+              const int want = expected.at<std::uint16_t>(y, k);
+              if (got == want) continue;
+              ++near_threshold;
+              const std::string where = name + " r=" + r_text(r) + " bits=" + std::to_string(bits) +
+                                        " t=" + std::to_string(frame.meta.index) + " at (" + std::to_string(k) +
+                                        ", " + std::to_string(y) + ")";
+              EXPECT_EQ(std::abs(got - want), 1) << where;
+              const double threshold = to_linear((std::max<double>(got, want) - 0.5) / top, link.transfer);
+              EXPECT_LT(std::abs(d_linear.at<double>(y, k) - threshold), 1.5 * grid_lsb) << where;
             }
           }
-          EXPECT_EQ(differing, 0) << name << " r=" << r_text(r) << " bits=" << bits << " t=" << frame.meta.index;
         }
       }
     }
   }
+  EXPECT_LE(near_threshold, 1);
 }
 
 // So the reduced frame that follows a static full frame is seen as static (w = 1 everywhere).

@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace trm {
 namespace {
@@ -60,6 +62,45 @@ TEST(HeadPose, SlerpOfTwoYawsIsTheYawInBetween) {
     EXPECT_NEAR(rotation_angle_deg(between, yaw(-1.0 + 3.0 * d)), 0.0, 1e-6) << d;
   }
   EXPECT_NEAR(rotation_angle_deg(yaw(0.25), yaw(-0.5)), 0.75, 1e-9);
+}
+
+// A head turning at a constant rate, known only at the frame starts: between them the fixated direction is where the
+// analytic turn puts it at that instant (c + f tan(alpha - omega t)), at every sub-frame time, not only at the frames.
+TEST(HeadPath, ConstantRateYawPutsTheFixatedPointAtTheAnalyticShiftAtEveryInstant) {
+  const PinholeView view = PinholeView::of_fov(540, 600, 100.0);
+  const double rate_deg_s = 10.0, period = 1.0 / 90.0;
+  std::vector<Eigen::Quaterniond> poses;
+  for (int f = 0; f <= 8; ++f) poses.push_back(yaw(rate_deg_s * f * period));
+  const HeadPath path(poses, period);
+  double worst = 0.0;
+  for (const cv::Point2d p : {view.centre(), cv::Point2d(12.0, 40.0), cv::Point2d(500.5, 599.0)}) {
+    for (int step = 0; step <= 8 * 16; ++step) {
+      const double t = step * period / 16.0;
+      const cv::Point2d got = path.fixated_pixel(p, t, view);
+      const cv::Point2d want = analytic_yaw_shift(p, rate_deg_s * t, view);
+      worst = std::max({worst, std::abs(got.x - want.x), std::abs(got.y - want.y)});
+    }
+  }
+  EXPECT_LT(worst, 1e-9);
+  // Outside the poses the head holds them.
+  EXPECT_EQ(path.fixated_pixel(view.centre(), -1.0, view), path.fixated_pixel(view.centre(), 0.0, view));
+  EXPECT_NEAR(path.fixated_pixel(view.centre(), 1.0, view).x, analytic_yaw_shift(view.centre(), rate_deg_s * 8 * period, view).x,
+              1e-9);
+}
+
+TEST(HeadPath, StillHeadKeepsTheFixatedPointWhereItIs) {
+  const PinholeView view = PinholeView::of_fov(216, 240, 100.0);
+  const Eigen::Quaterniond rest = yaw(0.3) * Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * kDeg, Eigen::Vector3d::UnitX()));
+  const HeadPath path(std::vector<Eigen::Quaterniond>(5, rest), 1.0 / 90.0);
+  const cv::Point2d p(33.25, 101.5);
+  for (const double t : {0.0, 0.004, 0.0111, 0.03, 0.5}) {
+    const cv::Point2d got = path.fixated_pixel(p, t, view);
+    EXPECT_NEAR(got.x, p.x, 1e-12) << t;
+    EXPECT_NEAR(got.y, p.y, 1e-12) << t;
+  }
+  EXPECT_THROW(HeadPath({}, 0.01), std::invalid_argument);
+  EXPECT_THROW(HeadPath({rest}, 0.0), std::invalid_argument);
+  EXPECT_THROW((void)path.orientation_at(std::nan("")), std::invalid_argument);
 }
 
 TEST(HeadPose, ReprojectedViewSamplesTheRenderedOneAtTheAnalyticShiftAndReplicatesItsEdge) {

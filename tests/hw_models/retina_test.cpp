@@ -245,6 +245,67 @@ TEST(HoldTypeBlur, ContinuousMotionUnderPerfectPursuitStaysSharp) {
   EXPECT_NEAR(edge_width_px(swept), 0.8 * 160.0, 0.02);
 }
 
+// ---- A gaze that follows a path (the head-rotation scenes' fixated world point) ----
+
+// A path that is a straight line in time is the constant-velocity eye; a path that stands still is fixation.
+TEST(GazePath, StraightPathIsPerfectPursuitAndAStillOneIsFixation) {
+  const EdgeCase edge;
+  const PanelLight oled = oled_light(EdgeCase::kRefresh, 0.2);
+  const double px_s = edge.speed_deg_s * edge.viewer.pixels_per_degree;
+  const Gaze straight = Gaze::following([px_s](double t) { return 17.0 + px_s * t; }, edge.speed_deg_s);
+  EXPECT_EQ(straight.target_retinal_velocity_deg_s(), 0.0);
+  RetinaOptions options;
+  options.substeps = 64;
+  EXPECT_LT(max_abs_difference(retinal_row(edge.frames, oled, edge.viewer, straight, options),
+                               retinal_row(edge.frames, oled, edge.viewer, edge.speed_deg_s, options)),
+            1e-12);
+  EXPECT_LT(max_abs_difference(target_frame_xt(edge.frames, oled, edge.viewer, straight, options),
+                               target_frame_xt(edge.frames, oled, edge.viewer, Gaze::perfect_pursuit(edge.speed_deg_s),
+                                               options)),
+            1e-12);
+  const Gaze still = Gaze::following([](double) { return 3.5; }, 0.0);
+  EXPECT_EQ(max_abs_difference(retinal_row(edge.frames, oled, edge.viewer, still, options),
+                               retinal_row(edge.frames, oled, edge.viewer, Gaze::fixation(edge.speed_deg_s), options)),
+            0.0);
+  EXPECT_EQ(max_abs_difference(retinal_xt(edge.frames, oled, edge.viewer, still, options),
+                               retinal_xt(edge.frames, oled, edge.viewer, 0.0, options)),
+            0.0);
+}
+
+// An eye whose speed changes at every frame (here +30, -15, +45, +10 deg/s in turn, a continuous path): each frame's
+// light is a still profile swept by the eye over the frame at that frame's speed, from where the eye stands at the
+// frame's start; the closed-form sweep (ideal_retinal_row) of each frame, averaged, is the oracle.
+TEST(GazePath, PiecewisePathIsEachFramesSweepAtItsOwnSpeed) {
+  const Viewer viewer = custom_viewer(30.0);
+  const PanelLight light = hold_light(90.0);
+  const double period = light.frame_period_s();
+  const std::vector<double> speeds_deg_s = {30.0, -15.0, 45.0, 10.0};
+  std::vector<double> start_px = {0.0};
+  for (const double v : speeds_deg_s) start_px.push_back(start_px.back() + v * viewer.pixels_per_degree * period);
+  const auto path = [&](double t) {
+    const int f = std::clamp(static_cast<int>(std::floor(t / period)), 0, 3);
+    return start_px[static_cast<std::size_t>(f)] + speeds_deg_s[static_cast<std::size_t>(f)] * viewer.pixels_per_degree *
+                                                       (t - f * period);
+  };
+  cv::Mat frames(4, 200, CV_64FC1);
+  for (int f = 0; f < 4; ++f) {
+    for (int i = 0; i < 200; ++i) frames.at<double>(f, i) = i < 90 + 3 * f ? 0.8 : 0.1 + 0.002 * i;
+  }
+  cv::Mat expected = cv::Mat::zeros(1, 200, CV_64FC1);
+  for (int f = 0; f < 4; ++f) {
+    const double v = speeds_deg_s[static_cast<std::size_t>(f)];
+    // x_eye(t) = v ppd (t − origin) passes through start_px[f] at the frame's start.
+    const double origin = f * period - start_px[static_cast<std::size_t>(f)] / (v * viewer.pixels_per_degree);
+    const cv::Mat swept = ideal_retinal_row(frames.row(f), viewer, Gaze{0.0, v}, f * period, (f + 1) * period, origin);
+    expected += swept / 4.0;
+  }
+  RetinaOptions options;
+  options.substeps = 256;
+  const cv::Mat got = retinal_row(frames, light, viewer, Gaze::following(path, 15.0), options);
+  // The sub-stepped integral's own error at this sweep (under 15 px per frame): sweep / (10 S^2) per unit contrast.
+  EXPECT_LT(max_abs_difference(got, expected), 0.7 * 15.0 / (10.0 * 256.0 * 256.0));
+}
+
 // ---- Talbot-Plateau: black frames, still eye ----
 
 TEST(RetinalIntegration, BlackFrameInsertionHalvesTheMeanLight) {
@@ -502,6 +563,11 @@ TEST(BadInput, ThrowsNamingTheArgument) {
   expect_invalid([&] { retinal_row(frames, light, viewer, kNaN); }, "eye_velocity_deg_s");
   expect_invalid([&] { retinal_row(frames, light, viewer, 1.0, no_steps); }, "substeps");
   expect_invalid([&] { retinal_xt(frames, light, viewer, kNaN); }, "frame_velocity_deg_s");
+  expect_invalid([] { Gaze::following({}, 0.0); }, "path_px");
+  expect_invalid([] { Gaze::following([](double) { return 0.0; }, kNaN); }, "mean_velocity_deg_s");
+  const Gaze wild = Gaze::following([](double t) { return t > 0.005 ? kNaN : 0.0; }, 0.0);
+  expect_invalid([&] { retinal_row(frames, light, viewer, wild); }, "gaze.path_px");
+  expect_invalid([&] { target_frame_xt(frames, light, viewer, wild); }, "gaze.path_px");
   expect_invalid([&] { retinal_image({frames}, light, viewer, 1.0, no_steps); }, "substeps");
   expect_invalid([&] { retinal_image({frames}, light, viewer, kNaN); }, "eye_velocity_deg_s");
   expect_invalid([&] { retinal_row(frames, light, Viewer{"bad", 0.0}, 1.0); }, "pixels_per_degree");

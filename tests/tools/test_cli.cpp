@@ -592,6 +592,38 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
   EXPECT_EQ(nlohmann::json::parse(in_two)["methods"].size(), 2u);
 }
 
+// On a head-rotation scene the eye fixates a world point and follows it through the head poses: on headturn's
+// constant 10 deg/s yaw the path is the pinhole's analytic shift of the view's middle column, -f tan(10 deg t), frame
+// by frame; a scene that moves its world is pursued at one speed with Eq. 3's lag.
+TEST(Cli, CompareEyeFollowsTheHeadPosesFrameByFrame) {
+  TempDir tmp;
+  const Result run =
+      run_trm("compare --methods full,reprojection --scene headturn --size 64x48 --frames 6 --out " + tmp.str("turn"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream in(tmp.str("turn/report.json"));
+  const nlohmann::json eye = nlohmann::json::parse(in)["eye"];
+  EXPECT_EQ(eye["gaze"], "head-pose fixation");
+  const auto& path = eye["path_px"];
+  ASSERT_EQ(path.size(), 7u);
+  const double kDeg = std::acos(-1.0) / 180.0;
+  const double focal = 32.0 / std::tan(50.0 * kDeg);
+  for (std::size_t f = 0; f < path.size(); ++f) {
+    EXPECT_NEAR(path[f].get<double>(), -focal * std::tan(10.0 * kDeg * static_cast<double>(f) / 90.0), 1e-9) << f;
+  }
+  // No lag: the eye's mean is the target's, the net travel over the run's duration in the viewer's degrees.
+  EXPECT_EQ(eye["eye_velocity_deg_s"].get<double>(), eye["target_velocity_deg_s"].get<double>());
+  EXPECT_NEAR(eye["target_velocity_deg_s"].get<double>(), path[6].get<double>() / (6.0 / 90.0) / 11.42, 1e-12);
+
+  const Result discs = run_trm("compare --methods full --scene discs --size 64x48 --frames 4 --out " + tmp.str("discs"));
+  ASSERT_EQ(discs.exit_code, 0) << discs.output;
+  std::ifstream in_discs(tmp.str("discs/report.json"));
+  const nlohmann::json pursued = nlohmann::json::parse(in_discs)["eye"];
+  EXPECT_EQ(pursued["gaze"], "pursuit");
+  EXPECT_FALSE(pursued.contains("path_px"));
+  const double target = pursued["target_velocity_deg_s"].get<double>();
+  EXPECT_NEAR(std::abs(pursued["eye_velocity_deg_s"].get<double>()), std::min(0.82 * std::abs(target) + 0.15, 80.0), 1e-12);
+}
+
 // Didyk et al.'s Fig. 8: upsampling 40 -> 120 Hz blurs a pursued edge less than native 40 Hz (each rendered frame held
 // three frames) and nearly as little as native 120 Hz, on the paper's hold-type LCD.
 TEST(Cli, DidykBlursLessThanNativeFortyHertzAndNearlyAsLittleAsOneTwenty) {

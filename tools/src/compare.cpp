@@ -5,6 +5,7 @@
 
 #include "trm/encoder_json.hpp"
 #include "trm/flicker.hpp"
+#include "trm/head_pose.hpp"
 #include "trm/metrics.hpp"
 #include "trm/mtcd.hpp"
 #include "trm/panel_light.hpp"
@@ -286,6 +287,7 @@ CompareResult run_compare(const CompareOptions& options,
   result.scan_line = target.scan_line;
   const double target_left = target.left, target_right = target.right;
   const Viewer viewer = options.ppd ? custom_viewer(*options.ppd) : viewer_preset(options.viewer);
+  std::unique_ptr<FrameSource> scaled_source;  // the scene at the asked speed, when one is asked
   if (options.speed_deg_s) {
     if (target_px_s == 0.0) {
       throw std::invalid_argument("--speed: scene '" + options.pipeline.scene + "' has no moving target to set the "
@@ -295,19 +297,52 @@ CompareResult run_compare(const CompareOptions& options,
     shown.motion_scale = *options.speed_deg_s / native_deg_s;
     target_px_s *= shown.motion_scale;
     result.motion_scale = shown.motion_scale;
-    (void)shown.open_source();  // the scene accepts the scale (throws its own message otherwise)
+    scaled_source = shown.open_source();  // the scene accepts the scale (throws its own message otherwise)
   }
+  const FrameSource& scene = scaled_source ? *scaled_source : *source;
   result.pixels_per_degree = viewer.pixels_per_degree;
   result.target_velocity_deg_s = target_px_s / viewer.pixels_per_degree;
   result.substeps = options.substeps > 0 ? options.substeps : kDefaultRetinaSubsteps;
   const PanelLight light = panel_light(options.pipeline.panel, options.pipeline.refresh_hz);
-  const Gaze gaze = Gaze::pursuit(result.target_velocity_deg_s);
+  const double duration_s = static_cast<double>(frames) / options.pipeline.refresh_hz;
+  Gaze gaze = Gaze::pursuit(result.target_velocity_deg_s);
+  Gaze exact_pursuit = Gaze::perfect_pursuit(result.target_velocity_deg_s);
+  double travel_px = target_px_s * duration_s;                                  // the target's, over the run
+  double largest_step_px = std::abs(target_px_s) / options.pipeline.refresh_hz;  // its most in one frame
+  if (const std::optional<HeadView> first = scene.head_view(0)) {
+    // Poses through the frame after the last: the last frame's light, delayed by its row's scan-out, reaches into it.
+    std::vector<Eigen::Quaterniond> poses;
+    for (std::int64_t f = 0; f <= frames + 1; ++f) poses.push_back(scene.head_view(f)->orientation);
+    const HeadPath head(std::move(poses), 1.0 / options.pipeline.refresh_hz);
+    const PinholeView projection = first->projection;
+    const cv::Point2d fixated(projection.centre().x, result.scan_line);
+    const auto x_of = [head, projection, fixated](double t_s) {
+      return head.fixated_pixel(fixated, t_s, projection).x;
+    };
+    double square_sum = 0.0;
+    largest_step_px = 0.0;
+    for (std::int64_t f = 0; f <= frames; ++f) {
+      result.gaze_path_px.push_back(x_of(static_cast<double>(f) / options.pipeline.refresh_hz) - x_of(0.0));
+      if (f == 0) continue;
+      const double step = result.gaze_path_px[static_cast<std::size_t>(f)] - result.gaze_path_px[static_cast<std::size_t>(f - 1)];
+      largest_step_px = std::max(largest_step_px, std::abs(step));
+      square_sum += step * step;
+    }
+    travel_px = result.gaze_path_px.back();
+    const double px_per_deg_s = viewer.pixels_per_degree / options.pipeline.refresh_hz;  // pixels per frame at 1 deg/s
+    result.gaze_rms_speed_deg_s = frames > 0 ? std::sqrt(square_sum / static_cast<double>(frames)) / px_per_deg_s : 0.0;
+    result.target_velocity_deg_s = travel_px / duration_s / viewer.pixels_per_degree;
+    result.gaze_follows_head = true;
+    gaze = Gaze::following(x_of, result.target_velocity_deg_s);
+    exact_pursuit = gaze;
+  }
+  result.eye_velocity_deg_s = gaze.eye_velocity_deg_s;
   RetinaOptions retina;
   retina.substeps = result.substeps;
   retina.row = result.scan_line;
   retina.rows = source->height();
   const double xt_rate = xt_samples_per_second(light, result.substeps);
-  const double lag = retinal_velocity_deg_s(result.target_velocity_deg_s);
+  const double lag = gaze.target_retinal_velocity_deg_s();
   cv::Mat profile;  // the scan line of the scene at t = 0: what moves continuously in the ideal reference
   // One method's run: its measures, and its scan line's x-t levels for the pursuit energies.
   const auto run_method = [&](const std::string& spec, cv::Mat& levels) {
@@ -355,9 +390,8 @@ CompareResult run_compare(const CompareOptions& options,
   // steepest edge of the target's line at t = 0, over the monotone run of the line that holds it, widened by the
   // blur and shift a frame-based display can add (three frames of travel).
   const int line_width = profile.empty() ? 0 : profile.cols;
-  const double duration_s = static_cast<double>(frames) / options.pipeline.refresh_hz;
   result.window_width = std::min(192, line_width);
-  const double path_centre = 0.5 * (target_left + target_right) + 0.5 * target_px_s * duration_s;
+  const double path_centre = 0.5 * (target_left + target_right) + 0.5 * travel_px;
   result.window_begin =
       std::clamp(static_cast<int>(std::lround(path_centre)) - result.window_width / 2, 0,
                  std::max(0, line_width - result.window_width));
@@ -376,7 +410,7 @@ CompareResult run_compare(const CompareOptions& options,
     int begin = edge, end = edge + 1;
     while (begin > 0 && (line[begin] - line[begin - 1]) * (rise > 0 ? 1 : -1) >= -tolerance) --begin;
     while (end + 1 < line_width && (line[end + 1] - line[end]) * (rise > 0 ? 1 : -1) >= -tolerance) ++end;
-    const int margin = static_cast<int>(std::ceil(3.0 * std::abs(target_px_s) / options.pipeline.refresh_hz)) + 4;
+    const int margin = static_cast<int>(std::ceil(3.0 * largest_step_px)) + 4;
     blur_begin = std::max(0, begin - margin);
     blur_end = std::min(line_width, end + 1 + margin);
     judder_begin = static_cast<int>(std::floor(target_left)) - margin;
@@ -397,7 +431,6 @@ CompareResult run_compare(const CompareOptions& options,
     blur_begin = blur_end = 0;
     result.continuous_blur_arcmin = std::numeric_limits<double>::quiet_NaN();
   }
-  const Gaze exact_pursuit = Gaze::perfect_pursuit(result.target_velocity_deg_s);
   // Judder from frame to frame: one sample per frame (the frame's light integrated), so the panel's own pulse
   // within a frame, which every method shares, is not counted; what is left is where each frame puts the target.
   RetinaOptions per_frame = retina;
@@ -432,11 +465,15 @@ CompareResult run_compare(const CompareOptions& options,
                                                             full_rate_per_frame.colRange(target_columns).clone());
       }
       measure.motion_blur_arcmin =
-          edge_arcmin(retinal_row(levels, light, viewer, exact_pursuit.eye_velocity_deg_s, retina));
+          edge_arcmin(retinal_row(levels, light, viewer, exact_pursuit, retina));
+      const std::string eye_text = result.gaze_follows_head
+                                       ? ", eye on a world point through the head poses (mean " +
+                                             number(result.target_velocity_deg_s, 2) + " deg/s)"
+                                       : ", target " + number(result.target_velocity_deg_s, 1) + " deg/s, eye " +
+                                             number(gaze.eye_velocity_deg_s, 1) + " deg/s";
       XtFigureInput figure{spec + ": " + (options.pipeline.input.empty() ? options.pipeline.scene : options.pipeline.input) +
-                               ", target " + number(result.target_velocity_deg_s, 1) + " deg/s, eye " +
-                               number(gaze.eye_velocity_deg_s, 1) + " deg/s, " +
-                               number(options.pipeline.refresh_hz, 0) + " Hz, row " + std::to_string(result.scan_line),
+                               eye_text + ", " + number(options.pipeline.refresh_hz, 0) + " Hz, row " +
+                               std::to_string(result.scan_line),
                            levels, light, viewer, gaze, retina, result.window_begin, result.window_width};
       result.figures.push_back(xt_figure(figure));
     } else {
@@ -477,7 +514,13 @@ std::string compare_markdown(const CompareResult& result) {
       << p.refresh_hz << " Hz, r = " << p.encoder.reduction << ", panel " << p.panel.name << ", link "
       << (p.link_preset.empty() ? "dp1.4" : p.link_preset) << ". Fractions against full-rate rendering of the same "
       << "frames; flicker and pair PSNR at a fixed gaze (Talbot-Plateau); the energies (supplement Eqs. 1-4) for an eye "
-      << "pursuing the target at " << number(result.target_velocity_deg_s, 2) << " deg/s along row " << result.scan_line
+      << (result.gaze_follows_head
+              ? "fixating the world point at the middle of row " + std::to_string(result.scan_line) +
+                    " and following it through the head poses frame by frame (vestibulo-ocular reflex: no lag; mean " +
+                    number(result.target_velocity_deg_s, 2) + " deg/s, RMS per frame " +
+                    number(result.gaze_rms_speed_deg_s, 2) + " deg/s)"
+              : "pursuing the target at " + number(result.target_velocity_deg_s, 2) + " deg/s along row " +
+                    std::to_string(result.scan_line))
       << " at " << number(result.pixels_per_degree, 2) << " ppd, " << result.substeps << " sub-frame steps. "
       << "Flicker JND: the stCSF-weighted alternation at " << number(p.refresh_hz / 2.0, 1) << " Hz (1 = threshold of "
       << "a flickering grating filling the view; trm/flicker.hpp); blur: 10-90 % width of the target's steepest edge "
@@ -533,12 +576,17 @@ nlohmann::ordered_json compare_json(const CompareResult& result) {
   j["eye"] = {{"pixels_per_degree", result.pixels_per_degree},
               {"scan_line", result.scan_line},
               {"target_velocity_deg_s", result.target_velocity_deg_s},
-              {"eye_velocity_deg_s", eye_velocity_deg_s(result.target_velocity_deg_s)},
+              {"gaze", result.gaze_follows_head ? "head-pose fixation" : "pursuit"},
+              {"eye_velocity_deg_s", result.eye_velocity_deg_s},
               {"substeps", result.substeps},
               {"continuous_blur_arcmin", std::isfinite(result.continuous_blur_arcmin)
                                              ? nlohmann::ordered_json(result.continuous_blur_arcmin)
                                              : nlohmann::ordered_json(nullptr)},
               {"window", {result.window_begin, result.window_width}}};
+  if (result.gaze_follows_head) {
+    j["eye"]["rms_speed_deg_s"] = result.gaze_rms_speed_deg_s;
+    j["eye"]["path_px"] = result.gaze_path_px;
+  }
   nlohmann::ordered_json methods = nlohmann::ordered_json::array();
   for (const MethodMeasure& m : result.methods) {
     const auto finite = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };

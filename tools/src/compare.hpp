@@ -72,7 +72,15 @@ struct CompareResult {
   cv::Size size;
   double pixels_per_degree = 0.0;
   int scan_line = 0;                  // the row the eye model follows the target along
-  double target_velocity_deg_s = 0.0; // horizontal speed of the pursued target
+  double target_velocity_deg_s = 0.0; // horizontal speed of the pursued target (on a head path: its mean)
+  double eye_velocity_deg_s = 0.0;    // pursuit: supplement Eq. 3; on a head path: its mean
+  // The scenes whose motion is the head rotating (FrameSource::head_view): the eye fixates the world point at the
+  // scan line's middle column at t = 0 and follows its display path through the head poses frame by frame
+  // (trm/head_pose.hpp's HeadPath, Gaze::following: the vestibulo-ocular reflex holds it still on the retina). Other
+  // scenes: the constant-speed pursuit of Eq. 3.
+  bool gaze_follows_head = false;
+  std::vector<double> gaze_path_px;   // on a head path: the fixated point's x at each frame's start, from its t = 0 place
+  double gaze_rms_speed_deg_s = 0.0;  // on a head path: the RMS over frames of its speed within each frame
   double motion_scale = 1.0;          // the scene's motions scaled by this (--speed)
   int substeps = 0;
   double continuous_blur_arcmin = 0.0;  // motion_blur_arcmin of the target moving continuously (its own edge)

@@ -107,7 +107,7 @@ cv::Mat xt_figure(const XtFigureInput& input) {
   const cv::Rect window(input.window_begin, 0, width, 0);
   const cv::Mat physical_line = retinal_xt(input.levels, input.light, input.viewer, 0.0, input.retina);
   const cv::Mat retinal_line =
-      retinal_xt(input.levels, input.light, input.viewer, input.gaze.eye_velocity_deg_s, input.retina);
+      retinal_xt(input.levels, input.light, input.viewer, input.gaze, input.retina);
   const cv::Rect rows_window(window.x, 0, width, physical_line.rows);
   const cv::Mat physical = physical_line(rows_window).clone();
   const cv::Mat retinal = retinal_line(rows_window).clone();

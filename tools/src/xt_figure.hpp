@@ -26,7 +26,8 @@ struct XtFigureInput {
 // An RGB CV_8UC3 image, four panels left to right. Time runs down each x–t panel (K·S rows of the sub-frame
 // samples), x across. The Fourier panel is log |F| of the physical panel, zero frequency at the centre, spatial
 // frequency across and temporal frequency down, tinted where the stCSF of the eye (retinal velocity −v_eye in the
-// screen's frame) is at least 1: energy outside the tint is invisible, aliases inside it are judder or flicker.
+// screen's frame; for a gaze on a path, its mean velocity) is at least 1: energy outside the tint is invisible,
+// aliases inside it are judder or flicker.
 // Throws std::invalid_argument naming what is wrong (empty levels, a window outside the line).
 cv::Mat xt_figure(const XtFigureInput& input);
 

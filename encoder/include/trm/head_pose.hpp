@@ -11,6 +11,8 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include <vector>
+
 namespace trm {
 
 // A pinhole projection with square pixels and the principal point at the view's centre.
@@ -43,6 +45,28 @@ Eigen::Quaterniond interpolated_orientation(const Eigen::Quaterniond& previous, 
 
 // The angle between two orientations, in degrees.
 double rotation_angle_deg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b);
+
+// The head's orientation between the poses of consecutive frames, and where a fixated world direction is on the
+// display meanwhile: what the eye of a viewer holding a world point still on the retina follows (the vestibulo-ocular
+// reflex with pursuit) while the head rotates. Frame f's pose is the head at f · period_s (the frame's start, when its
+// content is rendered); between two frames the head turns at a constant rate along the shortest arc
+// (interpolated_orientation), so a turn at a constant angular velocity is exact at every instant, not only at the
+// frame starts. Before the first pose and after the last the head holds them.
+class HeadPath {
+ public:
+  // At least one orientation; period_s finite and > 0. Throws std::invalid_argument naming the argument.
+  HeadPath(std::vector<Eigen::Quaterniond> frame_orientations, double period_s);
+  Eigen::Quaterniond orientation_at(double t_s) const;
+  // Where the world direction a head at the first pose sees at `pixel` appears at time t (reproject_pixel from the
+  // first pose to orientation_at(t)); t_s finite, else std::invalid_argument.
+  cv::Point2d fixated_pixel(cv::Point2d pixel, double t_s, const PinholeView& projection) const;
+  double period_s() const { return period_s_; }
+  std::size_t frames() const { return orientations_.size(); }
+
+ private:
+  std::vector<Eigen::Quaterniond> orientations_;
+  double period_s_ = 0.0;
+};
 
 // The bilinear interpolation of a CV_64FC3 or CV_32FC3 image at (x, y) (sample (i, j) at coordinate (i, j)), the
 // indices clamped (replicate border). Exact in double: OpenCV's remap and warp functions quantise the fraction to

@@ -25,6 +25,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -51,10 +52,16 @@ Viewer viewer_preset(const std::string& name);
 // A viewer of `pixels_per_degree` (finite and > 0; throws std::invalid_argument naming it), field of view not stated.
 Viewer custom_viewer(double pixels_per_degree);
 
-// Where the eye looks: a target moving at target_velocity_deg_s along x (negative: toward −x), and the eye's speed.
+// Where the eye looks: a target moving at target_velocity_deg_s along x (negative: toward −x), and the eye's speed;
+// or a target whose motion changes from frame to frame, given as its path, with the eye on it.
 struct Gaze {
   double target_velocity_deg_s = 0.0;
   double eye_velocity_deg_s = 0.0;
+  // When set: the target's position on the screen along x at time t (pixels; only x(t) − x(t_origin) counts), which
+  // the eye follows exactly. It replaces both velocities in every integral (the moving frame at each sub-step's middle
+  // is x(t) there, so the motion is piecewise at the eye's sub-frame steps); the velocities then hold the path's mean,
+  // for what needs one number (captions, the Fourier view's window of visibility).
+  std::function<double(double t_s)> path_px = {};
 
   // The eye holds still while the target moves (no drift: the Talbot-Plateau case).
   static Gaze fixation(double target_velocity_deg_s = 0.0);
@@ -62,6 +69,13 @@ struct Gaze {
   static Gaze pursuit(double target_velocity_deg_s);
   // The eye exactly on the target (the supplement's Fig. 1, right; the analytic hold-type blur cases).
   static Gaze perfect_pursuit(double target_velocity_deg_s);
+  // A world point fixated while the head rotates: the vestibulo-ocular reflex, with pursuit, holds it still on the
+  // retina whatever the head does, so the eye follows the point's display path frame by frame (trm/head_pose.hpp's
+  // HeadPath::fixated_pixel gives it for the head-rotation scenes), with no lag. Throws std::invalid_argument naming
+  // `path_px` when it is empty or `mean_velocity_deg_s` when it is not finite.
+  static Gaze following(std::function<double(double t_s)> path_px, double mean_velocity_deg_s);
+  // The target's velocity over the retina, target − eye: supplement Eq. 3's v_r for pursuit, 0 on a path.
+  double target_retinal_velocity_deg_s() const { return target_velocity_deg_s - eye_velocity_deg_s; }
 };
 // Each Gaze factory throws std::invalid_argument naming `target_velocity_deg_s` when it is not finite.
 
@@ -94,6 +108,10 @@ struct RetinaOptions {
 // `previous` of another size or type, eye_velocity_deg_s not finite, substeps < 1, row outside [0, rows)).
 cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, double eye_velocity_deg_s,
                     const RetinaOptions& options = {}, const cv::Mat& previous = {});
+// The same for the eye of `gaze`: its velocity, or its path (the path's values must be finite, else
+// std::invalid_argument naming `gaze.path_px`).
+cv::Mat retinal_row(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, const Gaze& gaze,
+                    const RetinaOptions& options = {}, const cv::Mat& previous = {});
 
 // The retinal image (time average) of whole frames, each row y delayed by its scan-out: same size and type as the
 // frames. `previous`: the LC state before frame 0, empty for settled; `previous_rate`: a second-order LC's rate
@@ -109,9 +127,13 @@ cv::Mat retinal_image(const std::vector<cv::Mat>& frames, const PanelLight& ligh
 // S · refresh per second for a DFT. Same arguments and errors as retinal_row.
 cv::Mat retinal_xt(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, double frame_velocity_deg_s,
                    const RetinaOptions& options = {}, const cv::Mat& previous = {});
+// retinal_xt in the frame of the eye of `gaze` (its velocity, or its path): the retinal x–t image, Fig. 12 column 2.
+cv::Mat retinal_xt(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, const Gaze& gaze,
+                   const RetinaOptions& options = {}, const cv::Mat& previous = {});
 
-// The supplement's x–t image for visual_difference_energy: retinal_xt in the frame that follows the target exactly
-// (the energy applies the lag itself: pass it xt_samples_per_second and retinal_velocity_deg_s(target)).
+// The supplement's x–t image for visual_difference_energy: retinal_xt in the frame that follows the target exactly,
+// at its velocity or along its path (the energy applies the lag itself: pass it xt_samples_per_second and
+// gaze.target_retinal_velocity_deg_s()).
 cv::Mat target_frame_xt(const cv::Mat& frames, const PanelLight& light, const Viewer& viewer, const Gaze& gaze,
                         const RetinaOptions& options = {}, const cv::Mat& previous = {});
 // Rows per second of retinal_xt and target_frame_xt: S · refresh. Throws std::invalid_argument naming `substeps`.
