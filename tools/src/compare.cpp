@@ -9,7 +9,6 @@
 #include "trm/metrics.hpp"
 #include "trm/mtcd.hpp"
 #include "trm/panel_light.hpp"
-#include "trm/pursuit.hpp"
 #include "trm/retina.hpp"
 #include "trm/visual_difference.hpp"
 #include "trm/transfer.hpp"
