@@ -104,6 +104,7 @@ struct LineScratch {
   ColumnBlendCache second_rows;  // and of `second` (d_{t-1})
   std::vector<Raw> shown;        // the line's emitted linear values
   std::vector<Raw> rho;          // a full frame's beta - shown
+  std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.

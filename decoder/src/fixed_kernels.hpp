@@ -237,6 +237,7 @@ class FixedKernels {
   double residual_to_double(Raw v) const { return static_cast<double>(v) * residual_lsb_; }
 
  private:
+  friend struct FixedLinePlans;  // the line kernels' plans copy the motion test's ROMs and constants
   FixedDecoderConfig config_;
   std::vector<Raw> code_rom_;
   std::unique_ptr<fx::InterpolatedLut> eotf_;  // encoded space only

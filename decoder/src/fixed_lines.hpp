@@ -5,6 +5,7 @@
 // lost lines, the LCD merge).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -50,10 +51,48 @@ struct DrivePlan {
   std::int64_t value_limit = 0;  // 2^value_bits: larger values take the generic search
 };
 
+// A uniform ROM whose segment position per code is 2^k (InterpolatedLut::segment_step): node = code >> j and weight
+// code mod 2^j for j = 32 - k, and the interpolation ((y_i << j) + (y_{i+1} - y_i) weight + 2^(j-1)) >> j is
+// InterpolatedLut::interpolate's add-half-and-shift divided through by 2^k. The last step is 0, as for EotfPlan.
+struct ShiftedRomPlan {
+  std::vector<std::int64_t> node;
+  std::vector<std::int64_t> step;
+  int weight_bits = 0;  // j
+};
+
+// The motion test and Eq. 4 of a reduced frame with a residual (FixedKernels::luma, motion_weight, contrast_of,
+// add_weighted_residual), for linear values in [0, 1] uQ1.F with F <= 30 (so every product is of 32-bit operands).
+struct MotionPlan {
+  std::array<std::uint32_t, 3> luma_weight{};  // uQ0.luma_shift
+  int luma_shift = 0;
+  int linear_frac_bits = 0;  // F
+  std::int64_t one = 0;      // 2^F
+  ShiftedRomPlan reciprocal;  // 1/m, m in [1, 2), uQ2.reciprocal_frac_bits
+  int reciprocal_input_bits = 0;
+  int reciprocal_frac_bits = 0;
+  std::uint32_t sensitivity = 0;  // s, uQ8.sensitivity_frac_bits
+  int exponent_shift = 0;         // s c (uQ.(S + F)) to uQ5.X
+  int exp_input_frac_bits = 0;    // X
+  ShiftedRomPlan exp_fraction;    // exp(-f), f in [0, 1), uQ1.F
+  std::array<std::int64_t, 16> exp_integer{};  // exp(-i), uQ1.F
+  int residual_frac_bits = 0;
+};
+
+// What the motion test and Eq. 4 of a line add to the frame's tally (FrameTally's fields of the same names).
+struct MotionTally {
+  std::uint64_t underflow = 0;
+  std::uint64_t clipped = 0;
+  std::int64_t weight_sum = 0;
+  std::int64_t dropped_sum = 0;
+  std::int64_t residual_abs_sum = 0;
+  std::int64_t residual_abs_max = 0;
+};
+
 // What the line kernels need from a configuration, or nothing where its formats do not fit their lanes.
 struct FixedLinePlans {
   std::optional<EotfPlan> eotf;    // encoded-space U and EOTF (8-bit sums, W <= 24, 2W > U, interpolation on 64 bits)
   std::optional<DrivePlan> drive;  // OLED drive codes
+  std::optional<MotionPlan> motion;  // finite, non-zero s; uniform reciprocal and exp ROMs with power-of-two steps
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
   std::int64_t one = 0;
 
@@ -76,6 +115,15 @@ void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& pla
 // rho[s] = beta - shown[s]. Returns the number of clipped samples (beta outside [0, one]).
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
                          const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho);
+// Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
+// whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions
+// of `kernels`.
+void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
+                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally);
+// Eq. 4 per sample: shown[s] = add_weighted_residual(alpha[s], weight[s / 3], residual[s]).alpha_prime for s < n.
+void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int64_t* shown,
+                            MotionTally& tally);
 // The instruction set the kernels dispatch to on this CPU (e.g. "AVX3", "AVX2", "SSE4").
 const char* target_name();
 

@@ -10,6 +10,7 @@
 #include <hwy/targets.h>
 
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,79 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
   }
 }
 
+// The motion kernels (Eqs. 4-6 over a line) against the stage functions, operand by operand: random linear values in
+// [0, 1], equal pairs (c = 0), black, the top value, sums of a few LSB (whose contrast shift leaves the lanes), values
+// outside [0, 1] (the stage functions' pixels), on every instruction set, at three sensitivities (s = 255 underflows
+// Eq. 6 wherever c > 1/16).
+TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  for (const double sensitivity : {10.0, 255.0, 0.01}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5), "vive");
+    config.decoder.sensitivity = sensitivity;
+    const fixed_detail::FixedKernels kernels(config);
+    const auto& plan = kernels.line_plans().motion;
+    ASSERT_TRUE(plan.has_value()) << "s = " << sensitivity;
+    const std::int64_t one = kernels.one();
+    constexpr std::size_t kPixels = 203;  // a tail after every vector width
+    std::mt19937_64 random(7);
+    std::uniform_int_distribution<std::int64_t> linear(0, one);
+    std::uniform_int_distribution<std::int64_t> tiny(0, 12);
+    std::uniform_int_distribution<std::int32_t> residual_value(-(1 << 29), (1 << 29) - 1);
+    std::vector<std::int64_t> previous(3 * kPixels), alpha(3 * kPixels);
+    std::vector<std::int32_t> residual(3 * kPixels);
+    for (std::size_t s = 0; s < 3 * kPixels; ++s) {
+      const std::size_t x = s / 3;
+      switch (x % 11) {
+        case 0: previous[s] = alpha[s] = linear(random); break;
+        case 1: previous[s] = alpha[s] = 0; break;
+        case 2: previous[s] = tiny(random); alpha[s] = tiny(random); break;
+        case 3: previous[s] = one; alpha[s] = linear(random); break;
+        case 4: previous[s] = x == 4 ? -1 : linear(random); alpha[s] = x == 15 ? one + 1 : linear(random); break;
+        default: previous[s] = linear(random); alpha[s] = linear(random); break;
+      }
+      residual[s] = x % 7 == 0 ? 0 : residual_value(random);
+    }
+    std::vector<std::int64_t> expected_weight(kPixels), expected_shown(3 * kPixels);
+    fixed_detail::MotionTally expected;
+    for (std::size_t x = 0; x < kPixels; ++x) {
+      bool underflow = false;
+      expected_weight[x] = kernels.motion_weight(kernels.luma(&previous[3 * x]), kernels.luma(&alpha[3 * x]), underflow);
+      expected.underflow += underflow ? 1 : 0;
+      expected.weight_sum += expected_weight[x];
+    }
+    for (std::size_t s = 0; s < 3 * kPixels; ++s) {
+      const fixed_detail::WeightedSample w = kernels.add_weighted_residual(alpha[s], expected_weight[s / 3], residual[s]);
+      expected_shown[s] = w.alpha_prime;
+      expected.clipped += w.clipped ? 1 : 0;
+      expected.dropped_sum += w.dropped;
+      const std::int64_t magnitude = residual[s] < 0 ? -std::int64_t{residual[s]} : residual[s];
+      expected.residual_abs_sum += magnitude;
+      expected.residual_abs_max = std::max(expected.residual_abs_max, magnitude);
+    }
+    EXPECT_GT(expected.clipped, 0u) << "the operands reach Eq. 4's clamp";
+    if (sensitivity == 255.0) {
+      EXPECT_GT(expected.underflow, 0u) << "the operands reach Eq. 6's underflow";
+    }
+    for (const std::int64_t target : targets) {
+      const TargetMock mock(target);
+      const std::string where = std::string(hwy::TargetName(target)) + " s=" + std::to_string(sensitivity);
+      std::vector<std::int64_t> weight(kPixels), shown(3 * kPixels);
+      fixed_detail::MotionTally tally;
+      fixed_detail::lines::motion_weights(previous.data(), alpha.data(), kPixels, *plan, kernels, weight.data(), tally);
+      fixed_detail::lines::add_weighted_residuals(alpha.data(), weight.data(), residual.data(), 3 * kPixels, *plan,
+                                                  kernels, shown.data(), tally);
+      for (std::size_t x = 0; x < kPixels; ++x) ASSERT_EQ(weight[x], expected_weight[x]) << where << " pixel " << x;
+      for (std::size_t s = 0; s < 3 * kPixels; ++s) ASSERT_EQ(shown[s], expected_shown[s]) << where << " sample " << s;
+      EXPECT_EQ(tally.underflow, expected.underflow) << where;
+      EXPECT_EQ(tally.weight_sum, expected.weight_sum) << where;
+      EXPECT_EQ(tally.clipped, expected.clipped) << where;
+      EXPECT_EQ(tally.dropped_sum, expected.dropped_sum) << where;
+      EXPECT_EQ(tally.residual_abs_sum, expected.residual_abs_sum) << where;
+      EXPECT_EQ(tally.residual_abs_max, expected.residual_abs_max) << where;
+    }
+  }
+}
+
 // The formats the kernels take: the defaults at an 8-bit link (U's sums in 32-bit lanes) and an OLED drive; a 10-bit
 // link's U sums exceed 32 bits and an LCD drive is the merge search, so those keep the per-sample steps.
 TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
@@ -107,6 +181,13 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   const FixedDecoderConfig oled = fixed_config(link_config(0.5), "vive");
   EXPECT_TRUE(plans_of(oled).eotf.has_value());
   EXPECT_TRUE(plans_of(oled).drive.has_value());
+  EXPECT_TRUE(plans_of(oled).motion.has_value());
+  FixedDecoderConfig still = oled;
+  still.decoder.sensitivity = 0.0;  // w = 1 everywhere: the stage function's shortcut
+  EXPECT_FALSE(plans_of(still).motion.has_value());
+  FixedDecoderConfig octave_exp = oled;
+  octave_exp.exp_entries = 1000;  // a segment step that is no power of two
+  EXPECT_FALSE(plans_of(octave_exp).motion.has_value());
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).eotf.has_value());
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5), "lcd")).drive.has_value());
   EXPECT_FALSE(plans_of(with_kernels(oled, false, true)).eotf.has_value());
