@@ -48,6 +48,7 @@ struct Geometry {
   std::vector<BilinearWeights> bilinear_cols;  // full.width entries
   std::vector<BilinearWeights> bilinear_rows;  // full.height entries
   ColumnBlendPlan column_blend;                // U's column taps per output sample, for the line kernels
+  GaussianColumnsPlan gauss_columns;           // D's horizontal taps as slots, for the line kernels
 };
 
 // Result of Eq. 2 and the split for one channel sample of a full frame.

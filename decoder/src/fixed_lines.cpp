@@ -185,6 +185,86 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
   return clipped;
 }
 
+void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                     std::int64_t* out) {
+  const std::size_t n = plan.samples;
+  const auto scalar = [&](std::size_t s) {
+    std::uint32_t acc = 0;
+    for (std::size_t t = 0; t < plan.taps; ++t) {
+      acc += plan.weight[t * n + s] * row[static_cast<std::size_t>(plan.index[t * n + s])];
+    }
+    const std::uint32_t kept = acc >> shift;
+    const std::uint32_t first = (acc >> (shift - 1)) & 1u;
+    const std::uint32_t rest = acc & ((std::uint32_t{1} << (shift - 1)) - 1u);
+    return static_cast<std::int64_t>(kept + (first & ((rest != 0 ? 1u : 0u) | (kept & 1u))));
+  };
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::uint32_t> du;
+  const hn::RebindToSigned<decltype(du)> di;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const hn::ScalableTag<std::int64_t> d64;
+  const hn::RebindToUnsigned<decltype(d64)> du64;
+  const hn::Rebind<std::uint32_t, decltype(du64)> d32h;
+  const std::size_t lanes = hn::Lanes(du);
+  thread_local std::vector<std::uint32_t> wide;
+  thread_local std::vector<std::uint32_t> sums;
+  wide.resize(row_samples + lanes);
+  sums.resize(n + lanes);
+  std::size_t i = 0;
+  for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
+  for (; i < row_samples; ++i) wide[i] = row[i];
+  const auto one = hn::Set(du, 1u);
+  const auto rest_mask = hn::Set(du, (std::uint32_t{1} << (shift - 1)) - 1u);
+  const auto zero = hn::Zero(du);
+  for (; s + lanes <= n; s += lanes) {
+    auto acc = zero;
+    for (std::size_t t = 0; t < plan.taps; ++t) {
+      const auto code = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.index.data() + t * n + s));
+      acc = hn::Add(acc, hn::Mul(hn::LoadU(du, plan.weight.data() + t * n + s), code));
+    }
+    // Half to even: up where the first dropped bit is set and the rest or the kept LSB is.
+    const auto kept = hn::ShiftRightSame(acc, shift);
+    const auto first = hn::And(hn::ShiftRightSame(acc, shift - 1), one);
+    const auto rest = hn::IfThenElseZero(hn::Ne(hn::And(acc, rest_mask), zero), one);
+    hn::StoreU(hn::Add(kept, hn::And(first, hn::Or(rest, hn::And(kept, one)))), du, sums.data() + s);
+  }
+  const std::size_t wide_lanes = hn::Lanes(d64);
+  std::size_t k = 0;
+  for (; k + wide_lanes <= s; k += wide_lanes) {
+    hn::StoreU(hn::BitCast(d64, hn::PromoteTo(du64, hn::LoadU(d32h, sums.data() + k))), d64, out + k);
+  }
+  for (; k < s; ++k) out[k] = sums[k];
+#endif
+  for (; s < n; ++s) out[s] = scalar(s);
+}
+
+void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                  int shift, std::uint16_t* out) {
+  std::size_t i = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto half = hn::Set(du, std::uint64_t{1} << (shift - 1));
+  for (; i + lanes <= n; i += lanes) {
+    auto acc = hn::Zero(du);
+    for (std::size_t j = 0; j < count; ++j) {
+      const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
+      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, hn::LoadU(d, rows[j] + i))));
+    }
+    hn::StoreU(hn::TruncateTo(d16, hn::ShiftRightSame(hn::Add(acc, half), shift)), d16, out + i);
+  }
+#endif
+  for (; i < n; ++i) {
+    std::uint64_t acc = 0;
+    for (std::size_t j = 0; j < count; ++j) acc += std::uint64_t{weight[j]} * static_cast<std::uint64_t>(rows[j][i]);
+    out[i] = static_cast<std::uint16_t>((acc + (std::uint64_t{1} << (shift - 1))) >> shift);
+  }
+}
+
 // The motion weight of one pixel and Eq. 4 of one sample by the stage functions (tails and out-of-lane operands).
 inline std::int64_t weight_scalar(const std::int64_t* previous, const std::int64_t* alpha, const FixedKernels& kernels,
                                   MotionTally& tally) {
@@ -461,6 +541,15 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     plans.motion = motion_plan(kernels, kernels.luma_weights_, *kernels.reciprocal_, *kernels.exp_fraction_,
                                kernels.sensitivity_raw_, kernels.exp_integer_rom_);
   }
+  {
+    const int T = c.gaussian_tap_frac_bits;
+    const int L = c.gaussian_line_frac_bits;
+    const auto max_code = static_cast<std::uint64_t>(kernels.max_code());
+    if (!kernels.linear_space() && T <= 31 && L >= 0 && T - L >= 1 && (max_code << T) < (std::uint64_t{1} << 32) &&
+        (max_code << L) < (std::uint64_t{1} << 32)) {
+      plans.gaussian = GaussianPlan{T - L, T + L};
+    }
+  }
   if (!kernels.lcd()) {
     DrivePlan d;
     d.mantissa_bits = ThresholdIndex::kMantissaBits;
@@ -509,6 +598,25 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
   return plan;
 }
 
+GaussianColumnsPlan gaussian_columns_plan(const Geometry& g) {
+  GaussianColumnsPlan plan;
+  plan.samples = 3 * static_cast<std::size_t>(g.reduced.width);
+  for (const PolyphaseTaps& taps : g.gauss_cols) plan.taps = std::max(plan.taps, taps.weight.size());
+  plan.index.assign(plan.taps * plan.samples, 0);
+  plan.weight.assign(plan.taps * plan.samples, 0);
+  for (std::size_t k = 0; k < g.gauss_cols.size(); ++k) {
+    const PolyphaseTaps& taps = g.gauss_cols[k];
+    for (std::size_t t = 0; t < taps.weight.size(); ++t) {
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        const std::size_t at = t * plan.samples + 3 * k + ch;
+        plan.index[at] = 3 * taps.index[t] + static_cast<int>(ch);
+        plan.weight[at] = static_cast<std::uint32_t>(taps.weight[t]);
+      }
+    }
+  }
+  return plan;
+}
+
 }  // namespace trm::fixed_detail
 
 namespace trm::fixed_detail::lines {
@@ -517,6 +625,8 @@ HWY_EXPORT(BlendColumns);
 HWY_EXPORT(BlendRowsEotf);
 HWY_EXPORT(DriveCodes);
 HWY_EXPORT(Compensate);
+HWY_EXPORT(GaussianColumns);
+HWY_EXPORT(GaussianRows);
 HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(TargetName);
@@ -534,6 +644,14 @@ void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& pla
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
                          const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho) {
   return HWY_DYNAMIC_DISPATCH(Compensate)(codes, low, n, code_rom, one, shown, rho);
+}
+void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                      std::int64_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianColumns)(row, row_samples, plan, shift, out);
+}
+void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                   int shift, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, out);
 }
 void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {

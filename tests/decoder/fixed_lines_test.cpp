@@ -5,10 +5,12 @@
 #include "fixed_decoder_test_support.hpp"
 #include "fixed_kernels.hpp"
 #include "fixed_lines.hpp"
+#include "trm/fx_quantise.hpp"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <array>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -172,6 +174,69 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
   }
 }
 
+// D's kernels against the rounding they name (fx::rounded_shift, half to even and half up) on random tap slots, a
+// third of them with weights that leave exact ties, on every instruction set.
+TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
+  std::mt19937_64 random(11);
+  constexpr std::size_t kRowSamples = 3 * 67;
+  constexpr std::size_t kSamples = 3 * 34 + 1;  // a tail after every vector width
+  constexpr std::size_t kTaps = 5;
+  constexpr int kHorizontalShift = 8;   // T - L at the defaults
+  constexpr int kVerticalShift = 40;    // T + L
+  fixed_detail::GaussianColumnsPlan plan;
+  plan.taps = kTaps;
+  plan.samples = kSamples;
+  std::uniform_int_distribution<std::int32_t> index(0, kRowSamples - 1);
+  std::uniform_int_distribution<std::uint32_t> weight(0, (1u << 24) / kTaps);
+  for (std::size_t t = 0; t < kTaps; ++t) {
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      plan.index.push_back(index(random));
+      const std::uint32_t w = weight(random);
+      plan.weight.push_back(s % 3 == 0 ? w & ~0x7fu : w);  // multiples of 2^7: half of those sums are exact ties
+    }
+  }
+  std::vector<std::uint16_t> row(kRowSamples);
+  for (std::uint16_t& code : row) code = static_cast<std::uint16_t>(random() % 256);
+  std::vector<std::int64_t> expected_columns(kSamples);
+  int ties = 0;
+  for (std::size_t s = 0; s < kSamples; ++s) {
+    std::int64_t acc = 0;
+    for (std::size_t t = 0; t < kTaps; ++t) acc += std::int64_t{plan.weight[t * kSamples + s]} * row[plan.index[t * kSamples + s]];
+    ties += (acc & 0xff) == 0x80 ? 1 : 0;
+    expected_columns[s] = fx::rounded_shift(acc, kHorizontalShift, fx::Quant::RndConv);
+  }
+  EXPECT_GT(ties, 4) << "the half-to-even rounding is exercised";
+  std::vector<std::vector<std::int64_t>> rows(kTaps, std::vector<std::int64_t>(kSamples));
+  std::array<std::uint32_t, kTaps> row_weight{};
+  for (std::size_t j = 0; j < kTaps; ++j) {
+    row_weight[j] = (weight(random) & ~((1u << 23) - 1)) | (j == 0 ? 1u << 23 : 0u);  // multiples of 2^23
+    for (std::size_t i = 0; i < kSamples; ++i) {
+      const auto value = static_cast<std::int64_t>(random() % (255u << 16));
+      rows[j][i] = i % 2 == 0 ? value & ~std::int64_t{0xffff} : value;  // multiples of 2^16: ties at bit 39
+    }
+  }
+  std::vector<const std::int64_t*> row_pointers;
+  for (const auto& r : rows) row_pointers.push_back(r.data());
+  std::vector<std::uint16_t> expected_rows(kSamples);
+  for (std::size_t i = 0; i < kSamples; ++i) {
+    std::int64_t acc = 0;
+    for (std::size_t j = 0; j < kTaps; ++j) acc += std::int64_t{row_weight[j]} * rows[j][i];
+    expected_rows[i] = static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd));
+  }
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    const TargetMock mock(target);
+    std::vector<std::int64_t> columns(kSamples);
+    fixed_detail::lines::gaussian_columns(row.data(), kRowSamples, plan, kHorizontalShift, columns.data());
+    std::vector<std::uint16_t> vertical(kSamples);
+    fixed_detail::lines::gaussian_rows(row_pointers.data(), row_weight.data(), kTaps, kSamples, kVerticalShift,
+                                       vertical.data());
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      ASSERT_EQ(columns[s], expected_columns[s]) << hwy::TargetName(target) << " horizontal sample " << s;
+      ASSERT_EQ(vertical[s], expected_rows[s]) << hwy::TargetName(target) << " vertical sample " << s;
+    }
+  }
+}
+
 // The formats the kernels take: the defaults at an 8-bit link (U's sums in 32-bit lanes) and an OLED drive; a 10-bit
 // link's U sums exceed 32 bits and an LCD drive is the merge search, so those keep the per-sample steps.
 TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
@@ -182,6 +247,8 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   EXPECT_TRUE(plans_of(oled).eotf.has_value());
   EXPECT_TRUE(plans_of(oled).drive.has_value());
   EXPECT_TRUE(plans_of(oled).motion.has_value());
+  EXPECT_TRUE(plans_of(oled).gaussian.has_value());
+  EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).gaussian.has_value());
   FixedDecoderConfig still = oled;
   still.decoder.sensitivity = 0.0;  // w = 1 everywhere: the stage function's shortcut
   EXPECT_FALSE(plans_of(still).motion.has_value());
