@@ -99,8 +99,9 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
     const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), p.blend_shift);     // uQb.U
     const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, p.weight_bits));
     const auto weight = hn::BitCast(di32, hn::And(upsampled, weight_mask));
-    const auto y0 = hn::GatherIndex(d, p.node.data(), node);
-    const auto step = hn::BitCast(di32, hn::GatherIndex(d, p.step.data(), node));
+    const auto word = hn::GatherIndex(d, p.packed.data(), node);
+    const auto y0 = hn::ShiftRight<32>(word);
+    const auto step = hn::BitCast(di32, word);  // the low halves, which MulEven reads
     const auto exact = hn::Add(hn::ShiftLeftSame(y0, p.weight_bits), hn::MulEven(step, weight));
     hn::StoreU(hn::ShiftRightSame(hn::Add(exact, weight_half), p.weight_bits), d, out + s);
   }
@@ -315,8 +316,9 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     const int j = rom.weight_bits;
     const auto node = hn::BitCast(d, hn::ShiftRightSame(code, j));
     const auto low = hn::BitCast(di32, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
-    const auto y0 = hn::GatherIndex(d, rom.node.data(), node);
-    const auto step = hn::BitCast(di32, hn::GatherIndex(d, rom.step.data(), node));
+    const auto word = hn::GatherIndex(d, rom.packed.data(), node);
+    const auto y0 = hn::ShiftRight<32>(word);
+    const auto step = hn::BitCast(di32, word);
     const auto exact = hn::Add(hn::ShiftLeftSame(y0, j), hn::MulEven(step, low));
     return hn::ShiftRightSame(hn::Add(exact, hn::Set(d, std::int64_t{1} << (j - 1))), j);
   };
@@ -439,6 +441,18 @@ namespace trm::fixed_detail {
 
 namespace {
 
+// node << 32 | (step mod 2^32) per word, or nothing where a node leaves [0, 2^31) or a step int32.
+std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64_t>& node,
+                                                    const std::vector<std::int64_t>& step) {
+  std::vector<std::int64_t> packed(node.size());
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    if (node[i] < 0 || node[i] > INT32_MAX || step[i] < INT32_MIN || step[i] > INT32_MAX) return std::nullopt;
+    packed[i] = static_cast<std::int64_t>((static_cast<std::uint64_t>(node[i]) << 32) |
+                                          static_cast<std::uint32_t>(step[i]));
+  }
+  return packed;
+}
+
 // The shift form of a uniform ROM (ShiftedRomPlan), where its segment position per code is 2^k with 1 <= k <= 31,
 // it rounds half up, and the interpolation's sum stays in 62 bits.
 std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
@@ -460,6 +474,9 @@ std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
     if (i + 1 < rom.size()) plan.step[i] = rom[i + 1] - rom[i];
     if (plan.step[i] < INT32_MIN || plan.step[i] > INT32_MAX) return std::nullopt;
   }
+  std::optional<std::vector<std::int64_t>> packed = packed_rom(plan.node, plan.step);
+  if (!packed) return std::nullopt;
+  plan.packed = std::move(*packed);
   return plan;
 }
 
@@ -535,7 +552,11 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     e.unit = std::uint32_t{1} << W;
     e.blend_shift = 2 * W - U;
     e.weight_bits = weight_bits;
-    if (steps_fit) plans.eotf = std::move(e);
+    std::optional<std::vector<std::int64_t>> packed = packed_rom(e.node, e.step);
+    if (steps_fit && packed) {
+      e.packed = std::move(*packed);
+      plans.eotf = std::move(e);
+    }
   }
   if (!kernels.sensitivity_infinite_ && c.decoder.sensitivity != 0.0 && kernels.reciprocal_ && kernels.exp_fraction_) {
     plans.motion = motion_plan(kernels, kernels.luma_weights_, *kernels.reciprocal_, *kernels.exp_fraction_,

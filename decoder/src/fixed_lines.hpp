@@ -31,6 +31,7 @@ struct ColumnBlendPlan {
 struct EotfPlan {
   std::vector<std::int64_t> node;
   std::vector<std::int64_t> step;
+  std::vector<std::int64_t> packed;  // node << 32 | step as 32 bits, for one gather per sample (nodes below 2^31)
   std::uint32_t unit = 0;  // 2^W
   int blend_shift = 0;     // 2W - U
   int weight_bits = 0;     // U - k
@@ -73,6 +74,7 @@ struct GaussianPlan {
 struct ShiftedRomPlan {
   std::vector<std::int64_t> node;
   std::vector<std::int64_t> step;
+  std::vector<std::int64_t> packed;  // as EotfPlan::packed
   int weight_bits = 0;  // j
 };
 
