@@ -199,16 +199,53 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     scratch.second.resize(n);
     upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
   }
-  // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line.
-  const bool whole_line = line_kernels(out);
+  // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line (an
+  // LCD's one sample after the other, as emit takes them: a reduced frame passes on no shortfall).
+  const bool whole_line = line_values(out);
   if (whole_line) scratch.shown.resize(n);
+  const std::optional<MotionPlan>& motion = kernels_.line_plans().motion;
+  if (whole_line && motion && residual_row != nullptr && !residual_zero) {
+    // Eqs. 4-6 over the line: w per pixel (1 on a static line, as reduced_pixel takes it), then alpha'.
+    const auto pixels = static_cast<std::size_t>(g.full.width);
+    scratch.weight.resize(pixels);
+    MotionTally m;
+    if (motion_static) {
+      std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
+      m.weight_sum = kernels_.one() * static_cast<Raw>(pixels);
+    } else {
+      lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,
+                            scratch.weight.data(), m);
+    }
+    lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
+                                  scratch.shown.data(), m);
+    FrameTally& t = out.tally;
+    t.weight_sum += m.weight_sum;
+    t.counts.weight_underflow += m.underflow;
+    t.clipped += m.clipped;
+    t.counts.alpha_clipped += m.clipped;
+    t.dropped_sum += m.dropped_sum;
+    t.residual_abs_sum += m.residual_abs_sum;
+    t.residual_abs_max = std::max(t.residual_abs_max, m.residual_abs_max);
+    emit_line(out, eye, y, scratch.shown.data());
+    return;
+  }
   Raw* shown = whole_line ? scratch.shown.data() : nullptr;
   for (int x = 0; x < g.full.width; ++x) {
     reduced_pixel(out, eye, y, x, scratch.first.data() + 3 * x,
                   previous_needed ? scratch.second.data() + 3 * x : nullptr, residual_row, gate, grey, shown);
   }
-  if (whole_line) {
-    lines::drive_codes(shown, n, *kernels_.line_plans().drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+  if (whole_line) emit_line(out, eye, y, shown);
+}
+
+void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown) const {
+  const std::optional<DrivePlan>& drive = kernels_.line_plans().drive;
+  if (drive) {
+    lines::drive_codes(shown, 3 * static_cast<std::size_t>(eye.full_size.width), *drive,
+                       out.frame.drive_codes.ptr<std::uint16_t>(y));
+    return;
+  }
+  for (int x = 0; x < eye.full_size.width; ++x) {
+    for (int ch = 0; ch < 3; ++ch) emit(out, eye, y, x, ch, shown[3 * x + ch]);
   }
 }
 

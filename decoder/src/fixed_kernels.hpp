@@ -48,6 +48,7 @@ struct Geometry {
   std::vector<BilinearWeights> bilinear_cols;  // full.width entries
   std::vector<BilinearWeights> bilinear_rows;  // full.height entries
   ColumnBlendPlan column_blend;                // U's column taps per output sample, for the line kernels
+  GaussianColumnsPlan gauss_columns;           // D's horizontal taps as slots, for the line kernels
 };
 
 // Result of Eq. 2 and the split for one channel sample of a full frame.
@@ -237,6 +238,7 @@ class FixedKernels {
   double residual_to_double(Raw v) const { return static_cast<double>(v) * residual_lsb_; }
 
  private:
+  friend struct FixedLinePlans;  // the line kernels' plans copy the motion test's ROMs and constants
   FixedDecoderConfig config_;
   std::vector<Raw> code_rom_;
   std::unique_ptr<fx::InterpolatedLut> eotf_;  // encoded space only

@@ -99,8 +99,9 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
     const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), p.blend_shift);     // uQb.U
     const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, p.weight_bits));
     const auto weight = hn::BitCast(di32, hn::And(upsampled, weight_mask));
-    const auto y0 = hn::GatherIndex(d, p.node.data(), node);
-    const auto step = hn::BitCast(di32, hn::GatherIndex(d, p.step.data(), node));
+    const auto word = hn::GatherIndex(d, p.packed.data(), node);
+    const auto y0 = hn::ShiftRight<32>(word);
+    const auto step = hn::BitCast(di32, word);  // the low halves, which MulEven reads
     const auto exact = hn::Add(hn::ShiftLeftSame(y0, p.weight_bits), hn::MulEven(step, weight));
     hn::StoreU(hn::ShiftRightSame(hn::Add(exact, weight_half), p.weight_bits), d, out + s);
   }
@@ -185,6 +186,250 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
   return clipped;
 }
 
+void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                     std::int64_t* out) {
+  const std::size_t n = plan.samples;
+  const auto scalar = [&](std::size_t s) {
+    std::uint32_t acc = 0;
+    for (std::size_t t = 0; t < plan.taps; ++t) {
+      acc += plan.weight[t * n + s] * row[static_cast<std::size_t>(plan.index[t * n + s])];
+    }
+    const std::uint32_t kept = acc >> shift;
+    const std::uint32_t first = (acc >> (shift - 1)) & 1u;
+    const std::uint32_t rest = acc & ((std::uint32_t{1} << (shift - 1)) - 1u);
+    return static_cast<std::int64_t>(kept + (first & ((rest != 0 ? 1u : 0u) | (kept & 1u))));
+  };
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::uint32_t> du;
+  const hn::RebindToSigned<decltype(du)> di;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const hn::ScalableTag<std::int64_t> d64;
+  const hn::RebindToUnsigned<decltype(d64)> du64;
+  const hn::Rebind<std::uint32_t, decltype(du64)> d32h;
+  const std::size_t lanes = hn::Lanes(du);
+  thread_local std::vector<std::uint32_t> wide;
+  thread_local std::vector<std::uint32_t> sums;
+  wide.resize(row_samples + lanes);
+  sums.resize(n + lanes);
+  std::size_t i = 0;
+  for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
+  for (; i < row_samples; ++i) wide[i] = row[i];
+  const auto one = hn::Set(du, 1u);
+  const auto rest_mask = hn::Set(du, (std::uint32_t{1} << (shift - 1)) - 1u);
+  const auto zero = hn::Zero(du);
+  for (; s + lanes <= n; s += lanes) {
+    auto acc = zero;
+    for (std::size_t t = 0; t < plan.taps; ++t) {
+      const auto code = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.index.data() + t * n + s));
+      acc = hn::Add(acc, hn::Mul(hn::LoadU(du, plan.weight.data() + t * n + s), code));
+    }
+    // Half to even: up where the first dropped bit is set and the rest or the kept LSB is.
+    const auto kept = hn::ShiftRightSame(acc, shift);
+    const auto first = hn::And(hn::ShiftRightSame(acc, shift - 1), one);
+    const auto rest = hn::IfThenElseZero(hn::Ne(hn::And(acc, rest_mask), zero), one);
+    hn::StoreU(hn::Add(kept, hn::And(first, hn::Or(rest, hn::And(kept, one)))), du, sums.data() + s);
+  }
+  const std::size_t wide_lanes = hn::Lanes(d64);
+  std::size_t k = 0;
+  for (; k + wide_lanes <= s; k += wide_lanes) {
+    hn::StoreU(hn::BitCast(d64, hn::PromoteTo(du64, hn::LoadU(d32h, sums.data() + k))), d64, out + k);
+  }
+  for (; k < s; ++k) out[k] = sums[k];
+#endif
+  for (; s < n; ++s) out[s] = scalar(s);
+}
+
+void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                  int shift, std::uint16_t* out) {
+  std::size_t i = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto half = hn::Set(du, std::uint64_t{1} << (shift - 1));
+  for (; i + lanes <= n; i += lanes) {
+    auto acc = hn::Zero(du);
+    for (std::size_t j = 0; j < count; ++j) {
+      const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
+      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, hn::LoadU(d, rows[j] + i))));
+    }
+    hn::StoreU(hn::TruncateTo(d16, hn::ShiftRightSame(hn::Add(acc, half), shift)), d16, out + i);
+  }
+#endif
+  for (; i < n; ++i) {
+    std::uint64_t acc = 0;
+    for (std::size_t j = 0; j < count; ++j) acc += std::uint64_t{weight[j]} * static_cast<std::uint64_t>(rows[j][i]);
+    out[i] = static_cast<std::uint16_t>((acc + (std::uint64_t{1} << (shift - 1))) >> shift);
+  }
+}
+
+// The motion weight of one pixel and Eq. 4 of one sample by the stage functions (tails and out-of-lane operands).
+inline std::int64_t weight_scalar(const std::int64_t* previous, const std::int64_t* alpha, const FixedKernels& kernels,
+                                  MotionTally& tally) {
+  bool underflow = false;
+  const std::int64_t w = kernels.motion_weight(kernels.luma(previous), kernels.luma(alpha), underflow);
+  tally.underflow += underflow ? 1 : 0;
+  tally.weight_sum += w;
+  return w;
+}
+
+inline std::int64_t weighted_scalar(std::int64_t alpha, std::int64_t weight, std::int32_t residual,
+                                    const FixedKernels& kernels, MotionTally& tally) {
+  const WeightedSample s = kernels.add_weighted_residual(alpha, weight, residual);
+  tally.clipped += s.clipped ? 1 : 0;
+  tally.dropped_sum += s.dropped;
+  const std::int64_t magnitude = residual < 0 ? -std::int64_t{residual} : std::int64_t{residual};
+  tally.residual_abs_sum += magnitude;
+  tally.residual_abs_max = std::max(tally.residual_abs_max, magnitude);
+  return s.alpha_prime;
+}
+
+void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
+                   const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+  std::size_t x = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Repartition<std::int32_t, decltype(d)> di32;
+  const hn::Rebind<double, decltype(d)> df;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto one = hn::Set(d, p.one);
+  const auto unit = hn::Set(d, std::int64_t{1});
+  const auto fifteen = hn::Set(d, std::int64_t{15});
+  const auto luma_weight_r = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.luma_weight[0]}));
+  const auto luma_weight_g = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.luma_weight[1]}));
+  const auto luma_weight_b = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.luma_weight[2]}));
+  const auto luma_half = hn::Set(du, std::uint64_t{1} << (p.luma_shift - 1));
+  const auto exponent_bias = hn::Set(d, std::int64_t{1023});
+  // c's rounding shift is lead + (reciprocal fraction bits - F); below 1 the stage function takes the pixel.
+  const auto contrast_shift_offset = hn::Set(d, std::int64_t{p.reciprocal_frac_bits - p.linear_frac_bits});
+  const auto sensitivity = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.sensitivity}));
+  const auto exponent_half = hn::Set(du, std::uint64_t{1} << (p.exponent_shift - 1));
+  const auto fraction_mask = hn::Set(du, (std::uint64_t{1} << p.exp_input_frac_bits) - 1);
+  const auto linear_half = hn::Set(du, std::uint64_t{1} << (p.linear_frac_bits - 1));
+  const auto interpolate = [&](const ShiftedRomPlan& rom, const auto code) {
+    const int j = rom.weight_bits;
+    const auto node = hn::BitCast(d, hn::ShiftRightSame(code, j));
+    const auto low = hn::BitCast(di32, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
+    const auto word = hn::GatherIndex(d, rom.packed.data(), node);
+    const auto y0 = hn::ShiftRight<32>(word);
+    const auto step = hn::BitCast(di32, word);
+    const auto exact = hn::Add(hn::ShiftLeftSame(y0, j), hn::MulEven(step, low));
+    return hn::ShiftRightSame(hn::Add(exact, hn::Set(d, std::int64_t{1} << (j - 1))), j);
+  };
+  const auto luma = [&](const auto r, const auto g, const auto b) {
+    const auto sum = hn::Add(hn::Add(hn::MulEven(luma_weight_r, hn::BitCast(du32, r)),
+                                     hn::MulEven(luma_weight_g, hn::BitCast(du32, g))),
+                             hn::MulEven(luma_weight_b, hn::BitCast(du32, b)));
+    return hn::BitCast(d, hn::ShiftRightSame(hn::Add(sum, luma_half), p.luma_shift));  // uQ1.F
+  };
+  const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero), hn::Gt(v, one)); };
+  auto weight_sum = zero;
+  for (; x + lanes <= pixels; x += lanes) {
+    hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
+    hn::LoadInterleaved3(d, previous + 3 * x, pr, pg, pb);
+    hn::LoadInterleaved3(d, alpha + 3 * x, ar, ag, ab);
+    const auto out_of_lanes = hn::Or(hn::Or(hn::Or(outside(pr), outside(pg)), hn::Or(outside(pb), outside(ar))),
+                                     hn::Or(outside(ag), outside(ab)));
+    const auto yp = luma(pr, pg, pb);
+    const auto ya = luma(ar, ag, ab);
+    const auto sum = hn::Add(yp, ya);                                  // uQ2.F
+    const auto difference = hn::Sub(hn::Max(yp, ya), hn::Min(yp, ya));
+    const auto still = hn::Eq(difference, zero);                       // c = 0: w = 1
+    // The leading one of the sum from its double's exponent (the sum < 2^53 is exact), then Eq. 5 by the normalised
+    // reciprocal: m's fraction aligned to the ROM's input bits is (sum - 2^lead) 2^B >> lead.
+    const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, sum)))), exponent_bias);
+    const auto contrast_shift = hn::Add(lead, contrast_shift_offset);
+    if (!hn::AllFalse(d, hn::Or(out_of_lanes, hn::AndNot(still, hn::Lt(contrast_shift, unit))))) {
+      for (std::size_t i = 0; i < lanes; ++i) {
+        weight[x + i] = weight_scalar(previous + 3 * (x + i), alpha + 3 * (x + i), kernels, tally);
+      }
+      continue;
+    }
+    const auto lead_u = hn::BitCast(du, hn::IfThenElse(still, zero, lead));
+    const auto below = hn::Sub(hn::BitCast(du, sum), hn::BitCast(du, hn::IfThenElse(still, zero, hn::BitCast(d, hn::Shl(hn::BitCast(du, unit), lead_u)))));
+    // (A still pixel, whose w is 1 whatever c, reads node 0.)
+    const auto code = hn::BitCast(du, hn::IfThenZeroElse(still, hn::BitCast(d, hn::Shr(hn::ShiftLeftSame(below, p.reciprocal_input_bits), lead_u))));
+    const auto mantissa = interpolate(p.reciprocal, code);  // 1/m, uQ2.24 at the defaults
+    const auto product = hn::MulEven(hn::BitCast(du32, difference), hn::BitCast(du32, mantissa));
+    const auto shift_u = hn::BitCast(du, hn::IfThenElse(still, unit, contrast_shift));
+    const auto half = hn::Shr(hn::Shl(hn::BitCast(du, unit), shift_u), hn::BitCast(du, unit));
+    const auto contrast = hn::Min(hn::BitCast(d, hn::Shr(hn::Add(product, half), shift_u)), one);  // uQ1.F
+    // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
+    const auto exponent = hn::ShiftRightSame(hn::Add(hn::MulEven(sensitivity, hn::BitCast(du32, contrast)), exponent_half),
+                                             p.exponent_shift);
+    const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, p.exp_input_frac_bits));
+    const auto underflow = hn::AndNot(still, hn::Gt(integer, fifteen));
+    const auto e_fraction = interpolate(p.exp_fraction, hn::And(exponent, fraction_mask));
+    const auto e_integer = hn::GatherIndex(d, p.exp_integer.data(), hn::Min(integer, fifteen));
+    const auto w = hn::BitCast(d, hn::ShiftRightSame(hn::Add(hn::MulEven(hn::BitCast(du32, e_integer),
+                                                                         hn::BitCast(du32, e_fraction)), linear_half),
+                                                     p.linear_frac_bits));
+    const auto result = hn::IfThenElse(still, one, hn::IfThenZeroElse(underflow, w));
+    tally.underflow += hn::CountTrue(d, underflow);
+    weight_sum = hn::Add(weight_sum, result);
+    hn::StoreU(result, d, weight + x);
+  }
+  tally.weight_sum += hn::GetLane(hn::SumOfLanes(d, weight_sum));
+#endif
+  for (; x < pixels; ++x) weight[x] = weight_scalar(previous + 3 * x, alpha + 3 * x, kernels, tally);
+}
+
+void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                          std::size_t n, [[maybe_unused]] const MotionPlan& p, const FixedKernels& kernels, std::int64_t* shown,
+                          MotionTally& tally) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::Rebind<std::int32_t, decltype(d)> d32;
+  const hn::Repartition<std::int32_t, decltype(d)> di32;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto one = hn::Set(d, p.one);
+  const auto residual_half = hn::Set(d, std::int64_t{1} << (p.residual_frac_bits - 1));
+  // Element e: e / 3, so that the pixels of the samples s0.. of a vector are s0 / 3 plus the elements (s0 mod 3)..
+  static const std::array<std::int64_t, 3 + DrivePlan::kMaxLanes> third = [] {
+    std::array<std::int64_t, 3 + DrivePlan::kMaxLanes> t{};
+    for (std::size_t e = 0; e < t.size(); ++e) t[e] = static_cast<std::int64_t>(e / 3);
+    return t;
+  }();
+  auto dropped = zero;
+  auto magnitude_sum = zero;
+  auto magnitude_max = zero;
+  std::size_t phase = 0;
+  const std::size_t phase_step = lanes % 3;
+  for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
+    const auto w = hn::GatherIndex(d, weight + s / 3, hn::LoadU(d, third.data() + phase));
+    if (!hn::AllFalse(d, hn::Or(hn::Lt(w, zero), hn::Gt(w, one)))) {
+      for (std::size_t i = 0; i < lanes; ++i) {
+        shown[s + i] = weighted_scalar(alpha[s + i], weight[(s + i) / 3], residual[s + i], kernels, tally);
+      }
+      continue;
+    }
+    const auto rho = hn::PromoteTo(d, hn::LoadU(d32, residual + s));
+    // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho (uQ1.F x sQ.R) rounded to F fraction bits.
+    const auto product = hn::MulEven(hn::BitCast(di32, w), hn::BitCast(di32, rho));
+    const auto sum = hn::Add(hn::LoadU(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), p.residual_frac_bits));
+    const auto clamped = hn::Min(hn::Max(sum, zero), one);
+    tally.clipped += hn::CountTrue(d, hn::Not(hn::Eq(clamped, sum)));
+    dropped = hn::Add(dropped, hn::Sub(hn::Max(sum, clamped), hn::Min(sum, clamped)));
+    const auto magnitude = hn::Max(rho, hn::Neg(rho));
+    magnitude_sum = hn::Add(magnitude_sum, magnitude);
+    magnitude_max = hn::Max(magnitude_max, magnitude);
+    hn::StoreU(clamped, d, shown + s);
+  }
+  tally.dropped_sum += hn::GetLane(hn::SumOfLanes(d, dropped));
+  tally.residual_abs_sum += hn::GetLane(hn::SumOfLanes(d, magnitude_sum));
+  tally.residual_abs_max = std::max(tally.residual_abs_max, hn::GetLane(hn::MaxOfLanes(d, magnitude_max)));
+#endif
+  for (; s < n; ++s) shown[s] = weighted_scalar(alpha[s], weight[s / 3], residual[s], kernels, tally);
+}
+
 const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
 
 }  // namespace HWY_NAMESPACE
@@ -193,6 +438,88 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace trm::fixed_detail {
+
+namespace {
+
+// node << 32 | (step mod 2^32) per word, or nothing where a node leaves [0, 2^31) or a step int32.
+std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64_t>& node,
+                                                    const std::vector<std::int64_t>& step) {
+  std::vector<std::int64_t> packed(node.size());
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    if (node[i] < 0 || node[i] > INT32_MAX || step[i] < INT32_MIN || step[i] > INT32_MAX) return std::nullopt;
+    packed[i] = static_cast<std::int64_t>((static_cast<std::uint64_t>(node[i]) << 32) |
+                                          static_cast<std::uint32_t>(step[i]));
+  }
+  return packed;
+}
+
+// The shift form of a uniform ROM (ShiftedRomPlan), where its segment position per code is 2^k with 1 <= k <= 31,
+// it rounds half up, and the interpolation's sum stays in 62 bits.
+std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
+  if (lut.is_direct() || lut.is_octave_segmented() || lut.shape().rounding != fx::Quant::Rnd) return std::nullopt;
+  const std::uint64_t step = lut.segment_step();
+  if (!std::has_single_bit(step)) return std::nullopt;
+  const int k = std::countr_zero(step);
+  if (k < 1 || k > 31) return std::nullopt;
+  ShiftedRomPlan plan;
+  plan.weight_bits = 32 - k;
+  const std::vector<std::int64_t>& rom = lut.rom();
+  const std::uint64_t top_node = ((std::uint64_t{1} << lut.shape().input_bits) - 1) >> plan.weight_bits;
+  if (top_node >= rom.size()) return std::nullopt;
+  plan.node = rom;
+  plan.step.assign(rom.size(), 0);
+  const std::int64_t limit = std::int64_t{1} << (61 - plan.weight_bits);
+  for (std::size_t i = 0; i < rom.size(); ++i) {
+    if (rom[i] <= -limit || rom[i] >= limit) return std::nullopt;
+    if (i + 1 < rom.size()) plan.step[i] = rom[i + 1] - rom[i];
+    if (plan.step[i] < INT32_MIN || plan.step[i] > INT32_MAX) return std::nullopt;
+  }
+  std::optional<std::vector<std::int64_t>> packed = packed_rom(plan.node, plan.step);
+  if (!packed) return std::nullopt;
+  plan.packed = std::move(*packed);
+  return plan;
+}
+
+// The motion test's plan: every product of MotionWeights / AddWeightedResiduals of 32-bit operands (F <= 30, the
+// weights, s, the ROM words and the mantissa below 2^32), every rounding shift at least 1.
+std::optional<MotionPlan> motion_plan(const FixedKernels& kernels, const std::array<std::int64_t, 3>& luma_weights,
+                                      const fx::InterpolatedLut& reciprocal, const fx::InterpolatedLut& exp_fraction,
+                                      std::int64_t sensitivity, const std::vector<std::int64_t>& exp_integer) {
+  const FixedDecoderConfig& c = kernels.config();
+  const int F = c.linear_frac_bits;
+  MotionPlan m;
+  m.linear_frac_bits = F;
+  m.one = kernels.one();
+  m.luma_shift = c.luma_weight_frac_bits;
+  m.reciprocal_input_bits = reciprocal.shape().input_bits;
+  m.reciprocal_frac_bits = reciprocal.shape().output_frac_bits;
+  m.exp_input_frac_bits = c.exp_input_frac_bits;
+  m.exponent_shift = c.sensitivity_frac_bits + F - c.exp_input_frac_bits;
+  m.residual_frac_bits = c.residual.frac_bits;
+  const auto below32 = [](std::int64_t v) { return v >= 0 && v < (std::int64_t{1} << 32); };
+  bool fits = F >= 1 && F <= 30 && m.luma_shift >= 1 && m.luma_shift + F <= 60 &&
+              F + 2 + m.reciprocal_input_bits <= 63 && reciprocal.shape().output_bits <= 32 &&
+              !reciprocal.shape().output_signed && exp_fraction.shape().output_bits <= 32 &&
+              !exp_fraction.shape().output_signed && exp_fraction.shape().input_bits == c.exp_input_frac_bits &&
+              m.exponent_shift >= 1 && m.residual_frac_bits >= 1 && below32(sensitivity) && exp_integer.size() == 16;
+  for (std::size_t i = 0; i < 3; ++i) {
+    fits = fits && below32(luma_weights[i]);
+    m.luma_weight[i] = static_cast<std::uint32_t>(luma_weights[i]);
+  }
+  for (std::size_t i = 0; i < 16 && fits; ++i) {
+    fits = fits && below32(exp_integer[i]);
+    m.exp_integer[i] = exp_integer[i];
+  }
+  std::optional<ShiftedRomPlan> r = shifted_rom_plan(reciprocal);
+  std::optional<ShiftedRomPlan> e = shifted_rom_plan(exp_fraction);
+  if (!fits || !r || !e) return std::nullopt;
+  m.sensitivity = static_cast<std::uint32_t>(sensitivity);
+  m.reciprocal = std::move(*r);
+  m.exp_fraction = std::move(*e);
+  return m;
+}
+
+}  // namespace
 
 FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   const FixedDecoderConfig& c = kernels.config();
@@ -225,7 +552,24 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     e.unit = std::uint32_t{1} << W;
     e.blend_shift = 2 * W - U;
     e.weight_bits = weight_bits;
-    if (steps_fit) plans.eotf = std::move(e);
+    std::optional<std::vector<std::int64_t>> packed = packed_rom(e.node, e.step);
+    if (steps_fit && packed) {
+      e.packed = std::move(*packed);
+      plans.eotf = std::move(e);
+    }
+  }
+  if (!kernels.sensitivity_infinite_ && c.decoder.sensitivity != 0.0 && kernels.reciprocal_ && kernels.exp_fraction_) {
+    plans.motion = motion_plan(kernels, kernels.luma_weights_, *kernels.reciprocal_, *kernels.exp_fraction_,
+                               kernels.sensitivity_raw_, kernels.exp_integer_rom_);
+  }
+  {
+    const int T = c.gaussian_tap_frac_bits;
+    const int L = c.gaussian_line_frac_bits;
+    const auto max_code = static_cast<std::uint64_t>(kernels.max_code());
+    if (!kernels.linear_space() && T <= 31 && L >= 0 && T - L >= 1 && (max_code << T) < (std::uint64_t{1} << 32) &&
+        (max_code << L) < (std::uint64_t{1} << 32)) {
+      plans.gaussian = GaussianPlan{T - L, T + L};
+    }
   }
   if (!kernels.lcd()) {
     DrivePlan d;
@@ -275,6 +619,25 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
   return plan;
 }
 
+GaussianColumnsPlan gaussian_columns_plan(const Geometry& g) {
+  GaussianColumnsPlan plan;
+  plan.samples = 3 * static_cast<std::size_t>(g.reduced.width);
+  for (const PolyphaseTaps& taps : g.gauss_cols) plan.taps = std::max(plan.taps, taps.weight.size());
+  plan.index.assign(plan.taps * plan.samples, 0);
+  plan.weight.assign(plan.taps * plan.samples, 0);
+  for (std::size_t k = 0; k < g.gauss_cols.size(); ++k) {
+    const PolyphaseTaps& taps = g.gauss_cols[k];
+    for (std::size_t t = 0; t < taps.weight.size(); ++t) {
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        const std::size_t at = t * plan.samples + 3 * k + ch;
+        plan.index[at] = 3 * taps.index[t] + static_cast<int>(ch);
+        plan.weight[at] = static_cast<std::uint32_t>(taps.weight[t]);
+      }
+    }
+  }
+  return plan;
+}
+
 }  // namespace trm::fixed_detail
 
 namespace trm::fixed_detail::lines {
@@ -283,6 +646,10 @@ HWY_EXPORT(BlendColumns);
 HWY_EXPORT(BlendRowsEotf);
 HWY_EXPORT(DriveCodes);
 HWY_EXPORT(Compensate);
+HWY_EXPORT(GaussianColumns);
+HWY_EXPORT(GaussianRows);
+HWY_EXPORT(MotionWeights);
+HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(TargetName);
 
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
@@ -298,6 +665,23 @@ void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& pla
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
                          const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho) {
   return HWY_DYNAMIC_DISPATCH(Compensate)(codes, low, n, code_rom, one, shown, rho);
+}
+void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                      std::int64_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianColumns)(row, row_samples, plan, shift, out);
+}
+void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                   int shift, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, out);
+}
+void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
+                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+  HWY_DYNAMIC_DISPATCH(MotionWeights)(previous, alpha, pixels, plan, kernels, weight, tally);
+}
+void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int64_t* shown,
+                            MotionTally& tally) {
+  HWY_DYNAMIC_DISPATCH(AddWeightedResiduals)(alpha, weight, residual, n, plan, kernels, shown, tally);
 }
 const char* target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 

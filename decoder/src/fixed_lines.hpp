@@ -5,6 +5,7 @@
 // lost lines, the LCD merge).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -30,6 +31,7 @@ struct ColumnBlendPlan {
 struct EotfPlan {
   std::vector<std::int64_t> node;
   std::vector<std::int64_t> step;
+  std::vector<std::int64_t> packed;  // node << 32 | step as 32 bits, for one gather per sample (nodes below 2^31)
   std::uint32_t unit = 0;  // 2^W
   int blend_shift = 0;     // 2W - U
   int weight_bits = 0;     // U - k
@@ -50,10 +52,66 @@ struct DrivePlan {
   std::int64_t value_limit = 0;  // 2^value_bits: larger values take the generic search
 };
 
+// D's horizontal half over a line (FixedKernels::gaussian_horizontal_line, encoded space), one entry per reduced
+// output sample s = 3k + ch of tap slot t at [t n + s] (n = 3 reduced.width): the row sample the tap reads and its
+// weight, uQ0.T; slots past a column's own taps weigh 0. Each exact sum stays below max_code 2^T < 2^32.
+struct GaussianColumnsPlan {
+  std::vector<std::int32_t> index;
+  std::vector<std::uint32_t> weight;
+  std::size_t taps = 0;     // slots per sample
+  std::size_t samples = 0;  // n
+};
+
+// D's rounding shifts where its sums fit 32-bit lanes (horizontal) and 32-bit operands (vertical).
+struct GaussianPlan {
+  int horizontal_shift = 0;  // T - L, half to even
+  int vertical_shift = 0;    // T + L, half up
+};
+
+// A uniform ROM whose segment position per code is 2^k (InterpolatedLut::segment_step): node = code >> j and weight
+// code mod 2^j for j = 32 - k, and the interpolation ((y_i << j) + (y_{i+1} - y_i) weight + 2^(j-1)) >> j is
+// InterpolatedLut::interpolate's add-half-and-shift divided through by 2^k. The last step is 0, as for EotfPlan.
+struct ShiftedRomPlan {
+  std::vector<std::int64_t> node;
+  std::vector<std::int64_t> step;
+  std::vector<std::int64_t> packed;  // as EotfPlan::packed
+  int weight_bits = 0;  // j
+};
+
+// The motion test and Eq. 4 of a reduced frame with a residual (FixedKernels::luma, motion_weight, contrast_of,
+// add_weighted_residual), for linear values in [0, 1] uQ1.F with F <= 30 (so every product is of 32-bit operands).
+struct MotionPlan {
+  std::array<std::uint32_t, 3> luma_weight{};  // uQ0.luma_shift
+  int luma_shift = 0;
+  int linear_frac_bits = 0;  // F
+  std::int64_t one = 0;      // 2^F
+  ShiftedRomPlan reciprocal;  // 1/m, m in [1, 2), uQ2.reciprocal_frac_bits
+  int reciprocal_input_bits = 0;
+  int reciprocal_frac_bits = 0;
+  std::uint32_t sensitivity = 0;  // s, uQ8.sensitivity_frac_bits
+  int exponent_shift = 0;         // s c (uQ.(S + F)) to uQ5.X
+  int exp_input_frac_bits = 0;    // X
+  ShiftedRomPlan exp_fraction;    // exp(-f), f in [0, 1), uQ1.F
+  std::array<std::int64_t, 16> exp_integer{};  // exp(-i), uQ1.F
+  int residual_frac_bits = 0;
+};
+
+// What the motion test and Eq. 4 of a line add to the frame's tally (FrameTally's fields of the same names).
+struct MotionTally {
+  std::uint64_t underflow = 0;
+  std::uint64_t clipped = 0;
+  std::int64_t weight_sum = 0;
+  std::int64_t dropped_sum = 0;
+  std::int64_t residual_abs_sum = 0;
+  std::int64_t residual_abs_max = 0;
+};
+
 // What the line kernels need from a configuration, or nothing where its formats do not fit their lanes.
 struct FixedLinePlans {
   std::optional<EotfPlan> eotf;    // encoded-space U and EOTF (8-bit sums, W <= 24, 2W > U, interpolation on 64 bits)
   std::optional<DrivePlan> drive;  // OLED drive codes
+  std::optional<MotionPlan> motion;  // finite, non-zero s; uniform reciprocal and exp ROMs with power-of-two steps
+  std::optional<GaussianPlan> gaussian;  // encoded space, max_code 2^T and max_code 2^L below 2^32
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
   std::int64_t one = 0;
 
@@ -62,6 +120,8 @@ struct FixedLinePlans {
 
 // The column blend plan of a view size (for FixedLinePlans::eotf).
 ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit);
+// D's horizontal taps of a view size as tap slots (for FixedLinePlans::gaussian).
+GaussianColumnsPlan gaussian_columns_plan(const Geometry& g);
 
 namespace lines {
 
@@ -76,6 +136,21 @@ void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& pla
 // rho[s] = beta - shown[s]. Returns the number of clipped samples (beta outside [0, one]).
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
                          const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho);
+// D's horizontal half: out[s] = round(sum_t weight[t n + s] row[index[t n + s]], T - L), half to even, for s < n.
+void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan,
+                      int shift, std::int64_t* out);
+// D's vertical half: out[i] = round(sum_j weight[j] rows[j][i], T + L), half up, for i < n (rows[j][i] < 2^32).
+void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                   int shift, std::uint16_t* out);
+// Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
+// whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions
+// of `kernels`.
+void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
+                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally);
+// Eq. 4 per sample: shown[s] = add_weighted_residual(alpha[s], weight[s / 3], residual[s]).alpha_prime for s < n.
+void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int64_t* shown,
+                            MotionTally& tally);
 // The instruction set the kernels dispatch to on this CPU (e.g. "AVX3", "AVX2", "SSE4").
 const char* target_name();
 

@@ -192,6 +192,7 @@ const Geometry& FixedKernels::geometry(cv::Size full) {
   g.bilinear_cols = bilinear_axis(full.width, g.reduced.width);
   g.bilinear_rows = bilinear_axis(full.height, g.reduced.height);
   if (line_plans_.eotf) g.column_blend = column_blend_plan(g, line_plans_.eotf->unit);
+  if (line_plans_.gaussian) g.gauss_columns = gaussian_columns_plan(g);
   return geometries_.emplace(key, std::move(g)).first->second;
 }
 

@@ -4,6 +4,7 @@
 #include "fixed_tables.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace trm::fixed_detail {
@@ -43,6 +44,11 @@ void FixedKernels::gaussian_horizontal_line(const std::uint16_t* codes_row, cons
     }
     return;
   }
+  if (line_plans_.gaussian && g.gauss_columns.samples == 3 * static_cast<std::size_t>(columns)) {
+    lines::gaussian_columns(codes_row, 3 * static_cast<std::size_t>(g.full.width), g.gauss_columns,
+                            line_plans_.gaussian->horizontal_shift, out);
+    return;
+  }
   const int shift = config_.gaussian_tap_frac_bits - config_.gaussian_line_frac_bits;
   for (int k = 0; k < columns; ++k) {
     const PolyphaseTaps& taps = g.gauss_cols[static_cast<std::size_t>(k)];
@@ -75,9 +81,17 @@ void FixedKernels::gaussian_vertical_row(const Raw* const* rows, const Polyphase
     for (int i = 0; i < samples; ++i) out[i] = grey && i % 3 > 0 ? out[i - i % 3] : gaussian_vertical(rows, taps, i);
     return;
   }
+  const std::size_t count = taps.weight.size();
+  constexpr std::size_t kMaxLineTaps = 64;
+  if (line_plans_.gaussian && count <= kMaxLineTaps) {
+    std::array<std::uint32_t, kMaxLineTaps> narrow{};
+    for (std::size_t j = 0; j < count; ++j) narrow[j] = static_cast<std::uint32_t>(taps.weight[j]);
+    lines::gaussian_rows(rows, narrow.data(), count, static_cast<std::size_t>(samples),
+                         line_plans_.gaussian->vertical_shift, out);
+    return;
+  }
   const int shift = config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits;
   const Raw* weight = taps.weight.data();
-  const std::size_t count = taps.weight.size();
   const int step = grey ? 3 : 1;
   for (int i = 0; i < samples; i += step) {
     Raw acc = 0;

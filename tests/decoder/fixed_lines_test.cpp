@@ -5,11 +5,14 @@
 #include "fixed_decoder_test_support.hpp"
 #include "fixed_kernels.hpp"
 #include "fixed_lines.hpp"
+#include "trm/fx_quantise.hpp"
 
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <array>
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -71,12 +74,14 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
     bool stereo;
     bool skip;
   };
-  // 67 pixels: 201 samples per line, a tail after every vector width; r = 0.4 gives non-dyadic U weights.
+  // 67 pixels: 201 samples per line, a tail after every vector width; r = 0.4 gives non-dyadic U weights; on the LCD
+  // the reduced frames take the line kernels up to the drive, which stays per sample.
   const std::vector<Case> cases = {
       {"panorama", 0.5, "vive", 8, false, true},  {"discs", 0.4, "rift", 10, false, true},
       {"checker", 0.5, "vive", 8, true, false},   {"text", 0.75, "vive", 8, false, true},
       {"zoneplate", 0.25, "rift", 8, false, true}, {"flash", 0.5, "vive", 10, false, true},
-      {"jitter", 0.5, "vive", 8, false, false},
+      {"jitter", 0.5, "vive", 8, false, false},  {"panorama", 0.5, "lcd", 8, false, true},
+      {"discs", 0.4, "lcd", 8, true, false},
   };
   const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());
@@ -98,6 +103,142 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
   }
 }
 
+// The motion kernels (Eqs. 4-6 over a line) against the stage functions, operand by operand: random linear values in
+// [0, 1], equal pairs (c = 0), black, the top value, sums of a few LSB (whose contrast shift leaves the lanes), values
+// outside [0, 1] (the stage functions' pixels), on every instruction set, at three sensitivities (s = 255 underflows
+// Eq. 6 wherever c > 1/16).
+TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  for (const double sensitivity : {10.0, 255.0, 0.01}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5), "vive");
+    config.decoder.sensitivity = sensitivity;
+    const fixed_detail::FixedKernels kernels(config);
+    const auto& plan = kernels.line_plans().motion;
+    ASSERT_TRUE(plan.has_value()) << "s = " << sensitivity;
+    const std::int64_t one = kernels.one();
+    constexpr std::size_t kPixels = 203;  // a tail after every vector width
+    std::mt19937_64 random(7);
+    std::uniform_int_distribution<std::int64_t> linear(0, one);
+    std::uniform_int_distribution<std::int64_t> tiny(0, 12);
+    std::uniform_int_distribution<std::int32_t> residual_value(-(1 << 29), (1 << 29) - 1);
+    std::vector<std::int64_t> previous(3 * kPixels), alpha(3 * kPixels);
+    std::vector<std::int32_t> residual(3 * kPixels);
+    for (std::size_t s = 0; s < 3 * kPixels; ++s) {
+      const std::size_t x = s / 3;
+      switch (x % 11) {
+        case 0: previous[s] = alpha[s] = linear(random); break;
+        case 1: previous[s] = alpha[s] = 0; break;
+        case 2: previous[s] = tiny(random); alpha[s] = tiny(random); break;
+        case 3: previous[s] = one; alpha[s] = linear(random); break;
+        case 4: previous[s] = x == 4 ? -1 : linear(random); alpha[s] = x == 15 ? one + 1 : linear(random); break;
+        default: previous[s] = linear(random); alpha[s] = linear(random); break;
+      }
+      residual[s] = x % 7 == 0 ? 0 : residual_value(random);
+    }
+    std::vector<std::int64_t> expected_weight(kPixels), expected_shown(3 * kPixels);
+    fixed_detail::MotionTally expected;
+    for (std::size_t x = 0; x < kPixels; ++x) {
+      bool underflow = false;
+      expected_weight[x] = kernels.motion_weight(kernels.luma(&previous[3 * x]), kernels.luma(&alpha[3 * x]), underflow);
+      expected.underflow += underflow ? 1 : 0;
+      expected.weight_sum += expected_weight[x];
+    }
+    for (std::size_t s = 0; s < 3 * kPixels; ++s) {
+      const fixed_detail::WeightedSample w = kernels.add_weighted_residual(alpha[s], expected_weight[s / 3], residual[s]);
+      expected_shown[s] = w.alpha_prime;
+      expected.clipped += w.clipped ? 1 : 0;
+      expected.dropped_sum += w.dropped;
+      const std::int64_t magnitude = residual[s] < 0 ? -std::int64_t{residual[s]} : residual[s];
+      expected.residual_abs_sum += magnitude;
+      expected.residual_abs_max = std::max(expected.residual_abs_max, magnitude);
+    }
+    EXPECT_GT(expected.clipped, 0u) << "the operands reach Eq. 4's clamp";
+    if (sensitivity == 255.0) {
+      EXPECT_GT(expected.underflow, 0u) << "the operands reach Eq. 6's underflow";
+    }
+    for (const std::int64_t target : targets) {
+      const TargetMock mock(target);
+      const std::string where = std::string(hwy::TargetName(target)) + " s=" + std::to_string(sensitivity);
+      std::vector<std::int64_t> weight(kPixels), shown(3 * kPixels);
+      fixed_detail::MotionTally tally;
+      fixed_detail::lines::motion_weights(previous.data(), alpha.data(), kPixels, *plan, kernels, weight.data(), tally);
+      fixed_detail::lines::add_weighted_residuals(alpha.data(), weight.data(), residual.data(), 3 * kPixels, *plan,
+                                                  kernels, shown.data(), tally);
+      for (std::size_t x = 0; x < kPixels; ++x) ASSERT_EQ(weight[x], expected_weight[x]) << where << " pixel " << x;
+      for (std::size_t s = 0; s < 3 * kPixels; ++s) ASSERT_EQ(shown[s], expected_shown[s]) << where << " sample " << s;
+      EXPECT_EQ(tally.underflow, expected.underflow) << where;
+      EXPECT_EQ(tally.weight_sum, expected.weight_sum) << where;
+      EXPECT_EQ(tally.clipped, expected.clipped) << where;
+      EXPECT_EQ(tally.dropped_sum, expected.dropped_sum) << where;
+      EXPECT_EQ(tally.residual_abs_sum, expected.residual_abs_sum) << where;
+      EXPECT_EQ(tally.residual_abs_max, expected.residual_abs_max) << where;
+    }
+  }
+}
+
+// D's kernels against the rounding they name (fx::rounded_shift, half to even and half up) on random tap slots, a
+// third of them with weights that leave exact ties, on every instruction set.
+TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
+  std::mt19937_64 random(11);
+  constexpr std::size_t kRowSamples = 3 * 67;
+  constexpr std::size_t kSamples = 3 * 34 + 1;  // a tail after every vector width
+  constexpr std::size_t kTaps = 5;
+  constexpr int kHorizontalShift = 8;   // T - L at the defaults
+  constexpr int kVerticalShift = 40;    // T + L
+  fixed_detail::GaussianColumnsPlan plan;
+  plan.taps = kTaps;
+  plan.samples = kSamples;
+  std::uniform_int_distribution<std::int32_t> index(0, kRowSamples - 1);
+  std::uniform_int_distribution<std::uint32_t> weight(0, (1u << 24) / kTaps);
+  for (std::size_t t = 0; t < kTaps; ++t) {
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      plan.index.push_back(index(random));
+      const std::uint32_t w = weight(random);
+      plan.weight.push_back(s % 3 == 0 ? w & ~0x7fu : w);  // multiples of 2^7: half of those sums are exact ties
+    }
+  }
+  std::vector<std::uint16_t> row(kRowSamples);
+  for (std::uint16_t& code : row) code = static_cast<std::uint16_t>(random() % 256);
+  std::vector<std::int64_t> expected_columns(kSamples);
+  int ties = 0;
+  for (std::size_t s = 0; s < kSamples; ++s) {
+    std::int64_t acc = 0;
+    for (std::size_t t = 0; t < kTaps; ++t) acc += std::int64_t{plan.weight[t * kSamples + s]} * row[plan.index[t * kSamples + s]];
+    ties += (acc & 0xff) == 0x80 ? 1 : 0;
+    expected_columns[s] = fx::rounded_shift(acc, kHorizontalShift, fx::Quant::RndConv);
+  }
+  EXPECT_GT(ties, 4) << "the half-to-even rounding is exercised";
+  std::vector<std::vector<std::int64_t>> rows(kTaps, std::vector<std::int64_t>(kSamples));
+  std::array<std::uint32_t, kTaps> row_weight{};
+  for (std::size_t j = 0; j < kTaps; ++j) {
+    row_weight[j] = (weight(random) & ~((1u << 23) - 1)) | (j == 0 ? 1u << 23 : 0u);  // multiples of 2^23
+    for (std::size_t i = 0; i < kSamples; ++i) {
+      const auto value = static_cast<std::int64_t>(random() % (255u << 16));
+      rows[j][i] = i % 2 == 0 ? value & ~std::int64_t{0xffff} : value;  // multiples of 2^16: ties at bit 39
+    }
+  }
+  std::vector<const std::int64_t*> row_pointers;
+  for (const auto& r : rows) row_pointers.push_back(r.data());
+  std::vector<std::uint16_t> expected_rows(kSamples);
+  for (std::size_t i = 0; i < kSamples; ++i) {
+    std::int64_t acc = 0;
+    for (std::size_t j = 0; j < kTaps; ++j) acc += std::int64_t{row_weight[j]} * rows[j][i];
+    expected_rows[i] = static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd));
+  }
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    const TargetMock mock(target);
+    std::vector<std::int64_t> columns(kSamples);
+    fixed_detail::lines::gaussian_columns(row.data(), kRowSamples, plan, kHorizontalShift, columns.data());
+    std::vector<std::uint16_t> vertical(kSamples);
+    fixed_detail::lines::gaussian_rows(row_pointers.data(), row_weight.data(), kTaps, kSamples, kVerticalShift,
+                                       vertical.data());
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      ASSERT_EQ(columns[s], expected_columns[s]) << hwy::TargetName(target) << " horizontal sample " << s;
+      ASSERT_EQ(vertical[s], expected_rows[s]) << hwy::TargetName(target) << " vertical sample " << s;
+    }
+  }
+}
+
 // The formats the kernels take: the defaults at an 8-bit link (U's sums in 32-bit lanes) and an OLED drive; a 10-bit
 // link's U sums exceed 32 bits and an LCD drive is the merge search, so those keep the per-sample steps.
 TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
@@ -107,6 +248,15 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   const FixedDecoderConfig oled = fixed_config(link_config(0.5), "vive");
   EXPECT_TRUE(plans_of(oled).eotf.has_value());
   EXPECT_TRUE(plans_of(oled).drive.has_value());
+  EXPECT_TRUE(plans_of(oled).motion.has_value());
+  EXPECT_TRUE(plans_of(oled).gaussian.has_value());
+  EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).gaussian.has_value());
+  FixedDecoderConfig still = oled;
+  still.decoder.sensitivity = 0.0;  // w = 1 everywhere: the stage function's shortcut
+  EXPECT_FALSE(plans_of(still).motion.has_value());
+  FixedDecoderConfig octave_exp = oled;
+  octave_exp.exp_entries = 1000;  // a segment step that is no power of two
+  EXPECT_FALSE(plans_of(octave_exp).motion.has_value());
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).eotf.has_value());
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5), "lcd")).drive.has_value());
   EXPECT_FALSE(plans_of(with_kernels(oled, false, true)).eotf.has_value());

@@ -114,6 +114,9 @@ class InterpolatedLut {
   double position_of(std::uint32_t code) const { return static_cast<double>(code) / input_span_; }
 
   bool is_direct() const { return direct_; }
+  // K of the uniform mode (segment position per input code, kSegmentFracBits fraction bits): where it is 2^k, the
+  // node is the code's top bits and the weight the rest shifted by k, which a caller may compute with shifts alone.
+  std::uint64_t segment_step() const { return segment_step_; }
   bool is_octave_segmented() const { return shape_.octaves > 0 && !direct_; }
   const std::string& name() const { return name_; }
   const LutShape& shape() const { return shape_; }
