@@ -154,7 +154,9 @@ TEST(Bandwidth, HeadsetStereoTrmFlattensThePeakAndNeedsLessLink) {
 }
 
 TEST(Bandwidth, CsvIsWritten) {
-  const std::filesystem::path dir = std::filesystem::path(TRM_BINARY_DIR) / "test_link_out";
+  // A directory of its own: the capture and link tests write (and stage) their files in test_link_out meanwhile.
+  const std::filesystem::path dir = std::filesystem::path(TRM_BINARY_DIR) / "test_link_out" / "bandwidth_csv";
+  std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   BandwidthMeter meter({parse_link_preset("custom:1:1"), 100.0, std::nullopt});
   const std::vector<LinkFrameUsage> frames = {meter.add(0, "F", ViewBits{100, 100, 20, 1}, 1),
