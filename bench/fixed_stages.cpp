@@ -1,7 +1,11 @@
 // The fixed-point decoder's stage kernels one line at a time (2160-pixel lines, r = 1/2, default formats, vive OLED
 // unless named), so that a change in decode time points at its stage. Items are channel samples of the stage's output
-// (pixels for the per-pixel motion weight). The kernels are the schedules' own (fixed_kernels.hpp).
+// (pixels for the per-pixel motion weight). The kernels are the schedules' own (fixed_kernels.hpp); the BM_Line*
+// ones are the line kernels (fixed_lines.hpp) the streaming decoder runs at these formats, at the instruction set
+// Highway dispatches to on this CPU (printed as the context's "line kernels"); D's two halves dispatch to theirs from
+// gaussian_horizontal_line and gaussian_vertical_row.
 #include "fixed_kernels.hpp"
+#include "fixed_lines.hpp"
 
 #include "trm/panel.hpp"
 
@@ -214,5 +218,88 @@ void BM_LcdDrive(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
 BENCHMARK(BM_LcdDrive)->Arg(0)->Arg(1);
+
+// The line kernels: U's column blend of two reduced rows and the row blend with the EOTF (one output line of L or
+// alpha, the column blends not cached), Eq. 2's split, Eqs. 5-6 per pixel, Eq. 4 and the OLED drive codes.
+void BM_LineUpsampleEotf(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  benchmark::AddCustomContext("line kernels", trm::fixed_detail::lines::target_name());
+  const std::vector<std::uint16_t> row0 = random_codes(3 * g.reduced.width, kernels.max_code(), 2);
+  const std::vector<std::uint16_t> row1 = random_codes(3 * g.reduced.width, kernels.max_code(), 3);
+  const auto n = static_cast<std::size_t>(3 * kWidth);
+  std::vector<std::uint32_t> top(n), bottom(n);
+  std::vector<Raw> out(n);
+  for (auto _ : state) {
+    trm::fixed_detail::lines::blend_columns(row0.data(), g.column_blend, n, top.data());
+    trm::fixed_detail::lines::blend_columns(row1.data(), g.column_blend, n, bottom.data());
+    trm::fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n,
+                                              static_cast<std::uint32_t>(g.bilinear_rows[1].upper),
+                                              *kernels.line_plans().eotf, out.data());
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineUpsampleEotf);
+
+void BM_LineCompensate(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<std::uint16_t> codes = random_codes(3 * kWidth, kernels.max_code(), 4);
+  const std::vector<Raw> low = random_linear(3 * kWidth, kernels.one(), 5);
+  std::vector<Raw> shown(codes.size()), rho(codes.size());
+  const auto& plans = kernels.line_plans();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(trm::fixed_detail::lines::compensate(codes.data(), low.data(), codes.size(),
+                                                                  plans.code_rom.data(), plans.one, shown.data(),
+                                                                  rho.data()));
+    benchmark::DoNotOptimize(rho.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineCompensate);
+
+void BM_LineMotionWeights(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 6);
+  const std::vector<Raw> alpha = random_linear(3 * kWidth, kernels.one(), 7);
+  std::vector<Raw> weight(static_cast<std::size_t>(kWidth));
+  for (auto _ : state) {
+    trm::fixed_detail::MotionTally tally;
+    trm::fixed_detail::lines::motion_weights(previous.data(), alpha.data(), weight.size(), *kernels.line_plans().motion,
+                                             kernels, weight.data(), tally);
+    benchmark::DoNotOptimize(weight.data());
+  }
+  state.SetItemsProcessed(state.iterations() * kWidth);
+}
+BENCHMARK(BM_LineMotionWeights);
+
+void BM_LineAddWeightedResiduals(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> alpha = random_linear(3 * kWidth, kernels.one(), 8);
+  const std::vector<Raw> weight = random_linear(kWidth, kernels.one(), 9);
+  const std::vector<Raw> wide_residual = random_linear(3 * kWidth, kernels.one() / 4, 10);
+  const std::vector<std::int32_t> residual(wide_residual.begin(), wide_residual.end());
+  std::vector<Raw> out(alpha.size());
+  for (auto _ : state) {
+    trm::fixed_detail::MotionTally tally;
+    trm::fixed_detail::lines::add_weighted_residuals(alpha.data(), weight.data(), residual.data(), out.size(),
+                                                     *kernels.line_plans().motion, kernels, out.data(), tally);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineAddWeightedResiduals);
+
+void BM_LineOledDriveCodes(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 11);
+  std::vector<std::uint16_t> codes(wanted.size());
+  for (auto _ : state) {
+    trm::fixed_detail::lines::drive_codes(wanted.data(), wanted.size(), *kernels.line_plans().drive, codes.data());
+    benchmark::DoNotOptimize(codes.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineOledDriveCodes);
 
 }  // namespace
