@@ -120,9 +120,9 @@ std::vector<SweepKnob> make_knobs() {
   // points the base decoder's output seen through each model.
   SweepKnob lc;
   lc.name = "lc_model";
-  lc.description = "LCD liquid-crystal model of the eye model's light: 0 first order (the preset's lc_response), "
-                   "1 first order overdriven, 2 second order (the preset's lc_second_order, or tau 2 ms, zeta 1), "
-                   "3 second order overdriven; held to 3 (the most state) at the base eye";
+  // Short enough for a plot title; sweep.hpp (lc_model_names) says which parameters each model takes.
+  lc.description = "LCD liquid-crystal model of the eye's light: first or second order (the preset's, or defaults), "
+                   "without or with overdrive; held to 3";
   lc.cost = "eye-model run time (the decoder's hardware is unchanged; overdrive is the panel's)";
   lc.values = {0, 1, 2, 3};
   lc.oled = false;

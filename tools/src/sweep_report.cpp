@@ -82,7 +82,7 @@ std::string value_text(const SweepKnob& k, const SweepPoint& p) {
 
 // What an eye-model knob's visual difference is measured against.
 std::string eye_reference_text(const SweepKnob& k) {
-  return k.lc_model ? "the " + k.value_label(kLcModelReference) + " LC" : std::string("the exact eye");
+  return k.lc_model ? k.value_label(kLcModelReference) : std::string("the exact eye");
 }
 
 std::string source_text(const SweepOptions& o) {
