@@ -297,6 +297,15 @@ void LcdPanel::validate(const std::string& what) const {
     }
     if (!(2.0 * (2.0 * p1 + p2) * v + 2.0 * p3 > 0.0)) fail("the held LCD merge M(v, v) must be increasing on [0, 1]");
   }
+  try {
+    LcResponse(lc_response, 1.0);  // the model's own ranges, named
+  } catch (const std::invalid_argument& e) {
+    fail(std::string("LCD lc_response: ") + e.what());
+  }
+  if (lc_second_order && lc_response != LcResponseParams{}) {
+    fail("LCD lc_response (the first-order LC) cannot be set together with lc_second_order: the panel has one LC "
+         "model");
+  }
   if (lc_second_order) {
     try {
       LcSecondOrder(*lc_second_order, 1.0);  // the model's own ranges, named
@@ -427,6 +436,11 @@ void write_panel(Json& out, const Panel& panel) {
   const LcdPanel& lcd = panel.lcd;
   out = {{"kind", "lcd"}, {"name", panel.name}, {"p1", lcd.p1}, {"p2", lcd.p2},
          {"p3", lcd.p3},  {"p4", lcd.p4},       {"gamma", lcd.gamma}};
+  if (lcd.lc_response != LcResponseParams{}) {
+    out["lc_response"] = {{"tau_off_s", lcd.lc_response.tau_off_s},
+                          {"drive_ratio", lcd.lc_response.drive_ratio},
+                          {"drive_gamma", lcd.lc_response.drive_gamma}};
+  }
   if (lcd.lc_second_order) {
     out["lc_second_order"] = {{"tau_s", lcd.lc_second_order->tau_s},
                               {"damping_ratio", lcd.lc_second_order->damping_ratio}};
@@ -450,6 +464,34 @@ double number_field(const Json& in, const char* key) {
   return value.template get<double>();
 }
 
+// Every field of `in` is one of `known` (what `where` takes): a misspelt field must not fall back to a default.
+template <typename Json>
+void reject_unknown_fields(const Json& in, const std::vector<std::string_view>& known, const std::string& where) {
+  for (const auto& item : in.items()) {
+    if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
+    std::string takes;
+    for (std::string_view k : known) takes.append(takes.empty() ? "" : ", ").append(k);
+    reject_json(where + " has an unknown field \"" + item.key() + "\" (it takes " + takes + ")");
+  }
+}
+
+// The object `key` of `in` with exactly the number fields `names`, or nullopt when `in` has no `key`.
+template <typename Json>
+std::optional<std::vector<double>> number_object(const Json& in, const char* key,
+                                                 const std::vector<std::string_view>& names) {
+  const auto found = in.find(key);
+  if (found == in.end()) return std::nullopt;
+  std::string takes;
+  for (std::string_view name : names) takes.append(takes.empty() ? "" : ", ").append(name);
+  if (!found->is_object()) {
+    reject_json(std::string("\"") + key + "\" must be an object, got " + found->dump() + " (it takes " + takes + ")");
+  }
+  reject_unknown_fields(*found, names, std::string("\"") + key + "\"");
+  std::vector<double> values;
+  for (std::string_view name : names) values.push_back(number_field(*found, std::string(name).c_str()));
+  return values;
+}
+
 template <typename Json>
 void read_panel(const Json& in, Panel& panel) {
   if (!in.is_object()) reject_json("expected an object, got " + in.dump());
@@ -459,6 +501,7 @@ void read_panel(const Json& in, Panel& panel) {
   Panel out;
   out.name = name.template get<std::string>();
   if (kind == "oled") {
+    reject_unknown_fields(in, {"kind", "name", "gamma", "duty"}, "an OLED panel");
     out.kind = PanelKind::Oled;
     const Json& gamma = field(in, "gamma");
     if (!gamma.is_array() || gamma.size() != 3) reject_json("\"gamma\" of an OLED panel must be 3 numbers (R, G, B)");
@@ -468,21 +511,20 @@ void read_panel(const Json& in, Panel& panel) {
     }
     out.oled.duty = number_field(in, "duty");
   } else if (kind == "lcd") {
+    reject_unknown_fields(
+        in, {"kind", "name", "p1", "p2", "p3", "p4", "gamma", "lc_response", "lc_second_order", "overdrive"},
+        "an LCD panel");
     out.kind = PanelKind::Lcd;
     out.lcd.p1 = number_field(in, "p1");
     out.lcd.p2 = number_field(in, "p2");
     out.lcd.p3 = number_field(in, "p3");
     out.lcd.p4 = number_field(in, "p4");
     out.lcd.gamma = number_field(in, "gamma");
-    if (const auto lc = in.find("lc_second_order"); lc != in.end()) {
-      constexpr const char* kTakes = " (it takes {\"tau_s\": s, \"damping_ratio\": zeta})";
-      if (!lc->is_object()) reject_json("\"lc_second_order\" must be an object, got " + lc->dump() + kTakes);
-      for (const auto& item : lc->items()) {
-        if (item.key() != "tau_s" && item.key() != "damping_ratio") {
-          reject_json("\"lc_second_order\" has an unknown field \"" + item.key() + "\"" + kTakes);
-        }
-      }
-      out.lcd.lc_second_order = LcSecondOrderParams{number_field(*lc, "tau_s"), number_field(*lc, "damping_ratio")};
+    if (const auto lc = number_object(in, "lc_response", {"tau_off_s", "drive_ratio", "drive_gamma"})) {
+      out.lcd.lc_response = LcResponseParams{(*lc)[0], (*lc)[1], (*lc)[2]};
+    }
+    if (const auto lc = number_object(in, "lc_second_order", {"tau_s", "damping_ratio"})) {
+      out.lcd.lc_second_order = LcSecondOrderParams{(*lc)[0], (*lc)[1]};
     }
     if (const auto overdrive = in.find("overdrive"); overdrive != in.end()) {
       if (!overdrive->is_boolean()) {

@@ -184,7 +184,7 @@ PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOp
     if (panel.lcd.lc_second_order) {
       config.lc_second_order = panel.lcd.lc_second_order;
     } else {
-      config.lc_response = options.lc_response;
+      config.lc_response = panel.lcd.lc_response;
     }
   }
   return PanelLight(config);

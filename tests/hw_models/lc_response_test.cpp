@@ -388,9 +388,9 @@ TEST(LcResponse, BadParametersAreRejectedByName) {
   PanelLightConfig nothing_to_overdrive;
   nothing_to_overdrive.overdrive = true;
   expect_invalid([&] { PanelLight{nothing_to_overdrive}; }, "'overdrive'");
-  PanelLightOptions options;
-  options.lc_response.drive_ratio = nan;
-  expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, options); }, "'drive_ratio'");
+  Panel panel = parse_panel("lcd");
+  panel.lcd.lc_response.drive_ratio = nan;
+  expect_invalid([&] { panel_light(panel, 90.0); }, "'drive_ratio'");
 }
 
 }  // namespace

@@ -223,8 +223,9 @@ TEST(HoldTypeBlur, StrobedBacklightBlursByTheStrobeAndTheCrystalAddsItsResponse)
   options.substeps = 512;
   PanelLightOptions strobe;
   strobe.strobe_duty = 0.25;
-  strobe.lc_response.tau_off_s = 1e-9;
-  const cv::Mat strobed = retinal_row(edge.frames, panel_light(parse_panel("lcd"), EdgeCase::kRefresh, strobe),
+  Panel instant_lcd = parse_panel("lcd");
+  instant_lcd.lcd.lc_response.tau_off_s = 1e-9;
+  const cv::Mat strobed = retinal_row(edge.frames, panel_light(instant_lcd, EdgeCase::kRefresh, strobe),
                                       edge.viewer, edge.speed_deg_s, options);
   EXPECT_NEAR(edge_width_px(strobed), 0.8 * 0.25 * 40.0, 0.01);
   // A slower crystal spreads each frame's edge over its response as well: wider than the instant hold.
@@ -551,9 +552,9 @@ TEST(BadInput, ThrowsNamingTheArgument) {
   PanelLightOptions strobe;
   strobe.strobe_duty = 0.0;
   expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, strobe); }, "strobe_duty");
-  PanelLightOptions tau;
-  tau.lc_response.tau_off_s = -1.0;
-  expect_invalid([&] { panel_light(parse_panel("lcd"), 90.0, tau); }, "tau_off_s");
+  Panel tau = parse_panel("lcd");
+  tau.lcd.lc_response.tau_off_s = -1.0;
+  expect_invalid([&] { panel_light(tau, 90.0); }, "tau_off_s");
 
   const cv::Mat frames(2, 8, CV_64FC1, cv::Scalar(0.5));
   const PanelLight light = hold_light(90.0);

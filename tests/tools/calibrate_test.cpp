@@ -146,7 +146,8 @@ TEST(Calibrate, BadInputIsRejectedWithAClearMessage) {
 TEST(Calibrate, CommandWritesAPresetThatPanelLoads) {
   const trm::test::ScratchDir scratch("trm-calibrate-");
   const std::filesystem::path out = scratch.path() / "cal";
-  const trm::test::TrmResult ok = trm::test::run_trm("calibrate --grid 5 --window 0.2 --noise 0.001 --out " + out.string());
+  const trm::test::TrmResult ok =
+      trm::test::run_trm("calibrate --grid 5 --window 0.2 --noise 0.001 --tau-off 0.0015 --out " + out.string());
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_NE(ok.output.find("Eq. 7 RMS"), std::string::npos) << ok.output;
   for (const char* name : {"panel.json", "readings.csv", "residuals.png"}) {
@@ -155,6 +156,9 @@ TEST(Calibrate, CommandWritesAPresetThatPanelLoads) {
   const Panel panel = parse_panel("lcd:" + (out / "panel.json").string());
   EXPECT_EQ(panel.kind, PanelKind::Lcd);
   EXPECT_EQ(panel.name, "calibrated");
+  // The preset describes the panel that was measured, its liquid crystal too.
+  EXPECT_EQ(panel.lcd.lc_response.tau_off_s, 0.0015);
+  EXPECT_EQ(panel.lcd.lc_response.drive_ratio, LcResponseParams{}.drive_ratio);
   // The preset is accepted where panels are parsed on the command line, too.
   const trm::test::TrmResult report = trm::test::run_trm("hw-report --panel lcd:" + (out / "panel.json").string());
   EXPECT_EQ(report.exit_code, 0) << report.output;

@@ -368,3 +368,102 @@ TEST(Sweep, PerceivedErrorFollowsTheDecodersCodes) {
   EXPECT_TRUE(std::isfinite(points[1].perceived_psnr_db));
   EXPECT_GT(points[0].visual_difference, 0.0);
 }
+
+// The LCD's LC model: the base decoder's output through each model against the reference (second order,
+// overdriven) at the base eye. The reference value is its own reference; the first-order crystal has no inertia, so
+// on moving discs it shows another light than the second-order one; the decoder's figures stay the base's.
+TEST(Sweep, LcModelIsHeldToTheSecondOrderOverdrivenCrystal) {
+  const trm::cli::SweepKnob* knob = trm::cli::find_sweep_knob("lc_model");
+  ASSERT_NE(knob, nullptr);
+  EXPECT_TRUE(knob->eye_model);
+  EXPECT_FALSE(knob->oled);
+  auto o = small_sweep("lc_model", 240, 32, 4);
+  o.pipeline.panel = trm::parse_panel("lcd");
+  const auto result = trm::cli::run_sweep(o);
+  ASSERT_EQ(result.knobs.size(), 1u);
+  EXPECT_EQ(result.knobs[0].default_value, 0);  // the plain LCD preset: first order, no overdrive
+  const auto& points = result.knobs[0].points;
+  ASSERT_EQ(points.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    const auto& p = points[static_cast<std::size_t>(i)];
+    ASSERT_TRUE(p.ok()) << i << ": " << p.message;
+    EXPECT_EQ(p.value, i);
+    EXPECT_EQ(p.is_default, i == 0);
+    EXPECT_EQ(p.codes, result.base.codes);
+    EXPECT_EQ(p.differing, result.base.differing);
+    EXPECT_EQ(p.on_chip_bits, result.base.on_chip_bits);
+    EXPECT_GT(p.eye_seconds_per_frame, 0.0);
+  }
+  EXPECT_EQ(knob->value_label(trm::cli::kLcModelReference), "second+overdrive");
+  EXPECT_EQ(points[3].visual_difference, 0.0);
+  EXPECT_TRUE(std::isinf(points[3].perceived_psnr_db));
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_GT(points[i].visual_difference, 0.0) << i;
+    EXPECT_TRUE(std::isfinite(points[i].perceived_psnr_db)) << i;
+  }
+  EXPECT_NE(points[0].visual_difference, points[2].visual_difference);
+  EXPECT_NE(points[0].perceived_psnr_db, points[2].perceived_psnr_db);
+
+  // The decoder does not depend on the LC model (Eq. 7's drive), so a base that is already the reference shows the
+  // same output through the same models: the same figures, exactly, with the base now the exact one.
+  auto detailed = o;
+  detailed.pipeline.panel.lcd.lc_second_order = trm::LcSecondOrderParams{};
+  detailed.pipeline.panel.lcd.overdrive = true;
+  detailed.values = {0};
+  const auto again = trm::cli::run_sweep(detailed);
+  EXPECT_EQ(again.knobs.at(0).default_value, trm::cli::kLcModelReference);
+  const auto& twice = again.knobs[0].points;
+  ASSERT_EQ(twice.size(), 2u);  // 0, and the base 3
+  EXPECT_TRUE(twice[1].is_default);
+  EXPECT_EQ(twice[1].visual_difference, 0.0);
+  EXPECT_EQ(twice[0].visual_difference, points[0].visual_difference);
+  EXPECT_EQ(twice[0].perceived_psnr_db, points[0].perceived_psnr_db);
+
+  trm::cli::SweepConfig config;
+  try {
+    knob->set(config, 4);
+    ADD_FAILURE() << "lc_model 4 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("lc_model 4 is none of the LC models 0..3"), std::string::npos) << e.what();
+  }
+  // An OLED has no liquid crystal: the knob is skipped with the reason, as the other LCD-only knobs are.
+  const auto oled = trm::cli::run_sweep(small_sweep("lc_model", 16, 12, 2));
+  ASSERT_EQ(oled.knobs.size(), 1u);
+  EXPECT_EQ(oled.knobs[0].skipped, "used with the LCD panel only");
+  EXPECT_TRUE(oled.knobs[0].points.empty());
+}
+
+// The LC model in the outputs: its values by name in sweep.csv, sweep.md, report.json and the knob list, and a
+// Pareto front of its own (its reference is not the exact eye's).
+TEST(Sweep, LcModelIsWrittenWithItsValueNames) {
+  ScratchDir tmp("trm-sweep-");
+  const auto ok = run_trm("sweep --quick --panel lcd --knob lc_model --knob eye_substeps -o " + tmp.str("out"));
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  const fs::path out = tmp.path() / "out";
+  std::vector<std::string> header;
+  const auto rows = read_csv(out / "sweep.csv", &header);
+  std::vector<std::string> labels;
+  for (const auto& row : rows) {
+    if (row.at("knob") == "lc_model") labels.push_back(row.at("value_label"));
+    if (row.at("knob") == "eye_substeps") {
+      EXPECT_EQ(row.at("value_label"), row.at("value"));
+    }
+  }
+  EXPECT_EQ(labels, trm::cli::lc_model_names());
+  std::ifstream md(out / "sweep.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("| **0 first** (base) |"), std::string::npos);
+  EXPECT_NE(text.find("| 3 second+overdrive |"), std::string::npos);
+  std::ifstream js(out / "report.json");
+  const auto report = nlohmann::json::parse(js);
+  ASSERT_EQ(report["pareto"].size(), 4u);
+  EXPECT_EQ(report["pareto"][3]["chart"], "LC model: error vs eye-model time");
+  for (const auto& point : report["pareto"][3]["front"]) EXPECT_EQ(point["knob"], "lc_model");
+  EXPECT_EQ(report["knobs"][0]["points"][3]["value_label"], "second+overdrive");
+  EXPECT_EQ(cv::imread((out / "sweep_pareto.png").string()).cols, 2400);
+  const auto list = run_trm("sweep --list-knobs");
+  ASSERT_EQ(list.exit_code, 0) << list.output;
+  EXPECT_NE(list.output.find("lc_model"), std::string::npos) << list.output;
+  EXPECT_NE(list.output.find("3=second+overdrive"), std::string::npos) << list.output;
+  EXPECT_NE(list.output.find("(LCD panel only)"), std::string::npos) << list.output;
+}

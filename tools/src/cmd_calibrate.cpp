@@ -59,7 +59,9 @@ void register_calibrate(CLI::App& app, Action& action) {
   cmd->add_option("--seed", options->seed, "Seed of the photometer noise")->capture_default_str();
   cmd->add_option("--native-gamma", options->native_gamma, "The simulated panel's held light v^gamma")
       ->capture_default_str();
-  cmd->add_option("--tau-off", options->lc.tau_off_s, "LC fall (elastic) time constant in s")->capture_default_str();
+  cmd->add_option("--tau-off", options->lc.tau_off_s,
+                  "LC fall (elastic) time constant in s (the written preset carries it)")
+      ->capture_default_str();
   cmd->add_option("--drive-ratio", options->lc.drive_ratio, "LC V_max / V_th (rise tau_off / ((V/V_th)^2 - 1))")
       ->capture_default_str();
   cmd->add_flag("--overdrive", options->overdrive,
@@ -76,6 +78,7 @@ void register_calibrate(CLI::App& app, Action& action) {
       panel.kind = PanelKind::Lcd;
       panel.name = "calibrated";
       panel.lcd = fit.panel;
+      panel.lcd.lc_response = options->lc;  // the preset is the simulated panel's, crystal included
       panel.lcd.overdrive = options->overdrive;
       nlohmann::ordered_json preset;
       to_json(preset, panel);

@@ -142,7 +142,10 @@ std::string knob_listing() {
   for (const auto& k : sweep_knobs()) {
     s << "  " << std::left << std::setw(30) << k.name << std::right << " default " << std::setw(5) << k.get(base)
       << "  values";
-    for (int v : k.values) s << " " << v;
+    for (int v : k.values) {
+      s << " " << v;
+      if (!k.value_names.empty()) s << "=" << k.value_label(v);
+    }
     s << "\n      " << k.description << "; cost: " << k.cost
       << (k.oled && k.lcd ? "" : k.oled ? " (OLED panels only)" : " (LCD panel only)")
       << (k.linear_space_only ? " (swept around a --resample-space linear base)" : "") << "\n";

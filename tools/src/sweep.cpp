@@ -116,6 +116,22 @@ std::vector<SweepKnob> make_knobs() {
   knobs.push_back(field_knob("lcd_segments_per_octave", "LCD target m = x^(1/gamma) LUT: segments per octave",
                              "ROM (LCD target)", {8, 16, 32, 64, 128, 256, 512, 1024, 2048},
                              &FixedDecoderConfig::lcd_segments_per_octave, false, true));
+  // The LC model is the eye's light, not the decoder (Eq. 7's drive does not depend on it): an eye-model knob, its
+  // points the base decoder's output seen through each model.
+  SweepKnob lc;
+  lc.name = "lc_model";
+  // Short enough for a plot title; sweep.hpp (lc_model_names) says which parameters each model takes.
+  lc.description = "LCD liquid-crystal model of the eye's light: first or second order (the preset's, or defaults), "
+                   "without or with overdrive; held to 3";
+  lc.cost = "eye-model run time (the decoder's hardware is unchanged; overdrive is the panel's)";
+  lc.values = {0, 1, 2, 3};
+  lc.oled = false;
+  lc.eye_model = true;
+  lc.lc_model = true;
+  lc.value_names = lc_model_names();
+  lc.get = [](const SweepConfig& c) { return lc_model_of(c.decoder.decoder.panel.lcd); };
+  lc.set = [](SweepConfig& c, int v) { set_lc_model(c.decoder.decoder.panel.lcd, v); };
+  knobs.push_back(std::move(lc));
   // The liquid crystal has no time step to sweep: each frame is its exact exponential segment (lc_response.hpp).
   // What is sampled within a frame is its light, by the eye's sub-steps (each integrates the light exactly and
   // takes the eye at the step's middle), so on an LCD this knob is also the sub-frame sampling of the LC light.
@@ -332,6 +348,33 @@ SweepPoint evaluate(const SweepConfig& config, const Sequence& seq, const EyeSet
 
 }  // namespace
 
+std::string SweepKnob::value_label(int value) const {
+  if (value >= 0 && static_cast<std::size_t>(value) < value_names.size()) return value_names[value];
+  return std::to_string(value);
+}
+
+const std::vector<std::string>& lc_model_names() {
+  static const std::vector<std::string> names = {"first", "first+overdrive", "second", "second+overdrive"};
+  return names;
+}
+
+int lc_model_of(const LcdPanel& lcd) { return (lcd.lc_second_order ? 2 : 0) + (lcd.overdrive ? 1 : 0); }
+
+void set_lc_model(LcdPanel& lcd, int model) {
+  const int models = static_cast<int>(lc_model_names().size());
+  if (model < 0 || model >= models) {
+    throw std::invalid_argument("lc_model " + std::to_string(model) + " is none of the LC models 0.." +
+                                std::to_string(models - 1));
+  }
+  if (model >= 2) {
+    if (!lcd.lc_second_order) lcd.lc_second_order = LcSecondOrderParams{};
+    lcd.lc_response = LcResponseParams{};  // the panel has one LC model (LcdPanel::validate)
+  } else {
+    lcd.lc_second_order.reset();
+  }
+  lcd.overdrive = model % 2 == 1;
+}
+
 const std::vector<SweepKnob>& sweep_knobs() {
   static const std::vector<SweepKnob> knobs = make_knobs();
   return knobs;
@@ -513,7 +556,7 @@ SweepResult run_sweep(const SweepOptions& options,
   // What this shard evaluates: its points (numbered as SweepShard numbers them), the sequences they decode or watch
   // (every shard that needs a base computes its output, eye points watching it), and the decodes that makes.
   bool needs_encoded = shard.owns(0), needs_linear = has_linear_base && shard.owns(linear_base_number);
-  bool any_eye = false;
+  bool any_exact_eye = false, any_lc = false;
   std::int64_t decodes = (shard.owns(0) ? 1 : 0) + (needs_linear ? 1 : 0);
   {
     std::int64_t number = has_linear_base ? linear_base_number : 0;
@@ -521,7 +564,8 @@ SweepResult run_sweep(const SweepOptions& options,
       for (int value : planned.values) {
         if (!sweep_is_point(planned, value) || !shard.owns(++number)) continue;
         (planned.linear_base ? needs_linear : needs_encoded) = true;
-        if (planned.knob->eye_model) any_eye = true;
+        if (planned.knob->lc_model) any_lc = true;
+        else if (planned.knob->eye_model) any_exact_eye = true;
         else ++decodes;
       }
     }
@@ -540,8 +584,11 @@ SweepResult run_sweep(const SweepOptions& options,
   result.reference_seconds_per_frame = encoded.rec.reference_seconds / static_cast<double>(result.views);
   result.recording_hash = recording_hash(encoded.rec);
   if (linear) result.linear_recording_hash = recording_hash(linear->rec);
-  const EyeSetup eye = eye_setup(panel, options.pipeline.output_bits, options.pipeline.refresh_hz,
-                                 target.velocity_px_s, target.scan_line, result.size.height);
+  const auto eye_of = [&](const Panel& shown_on) {
+    return eye_setup(shown_on, options.pipeline.output_bits, options.pipeline.refresh_hz, target.velocity_px_s,
+                     target.scan_line, result.size.height);
+  };
+  const EyeSetup eye = eye_of(panel);
   result.pixels_per_degree = eye.viewer.pixels_per_degree;
   result.target_velocity_deg_s = eye.target_velocity_deg_s;
   result.eye_velocity_deg_s = eye.eye_velocity_deg_s;
@@ -575,7 +622,15 @@ SweepResult run_sweep(const SweepOptions& options,
   if (linear && shard.owns(linear_base_number)) result.linear_base = linear->base;
   // The reference decoder's output seen by the exact eye, for the eye-model knobs (made when one is swept here).
   std::optional<PerceivedSequence> exact_seen;
-  if (any_eye) exact_seen = perceive(reference_shown(encoded.rec), eye, kExactEyeSubsteps);
+  if (any_exact_eye) exact_seen = perceive(reference_shown(encoded.rec), eye, kExactEyeSubsteps);
+  // The LC model's reference: the base decoder's output through the reference LC at the base eye, so that a point
+  // differs from it in the LC alone (the decoder's and the eye's own errors are the other knobs').
+  std::optional<PerceivedSequence> lc_reference_seen;
+  if (any_lc) {
+    Panel detailed = panel;
+    set_lc_model(detailed.lcd, kLcModelReference);
+    lc_reference_seen = perceive(encoded.base_shown, eye_of(detailed), encoded.base_config.eye_substeps);
+  }
 
   std::int64_t number = has_linear_base ? linear_base_number : 0;  // the last base point's
   for (const SweepPlanKnob& planned : plan) {
@@ -599,9 +654,14 @@ SweepResult run_sweep(const SweepOptions& options,
         set = false;
       }
       if (knob.eye_model) {
-        // The decoder is the base's (finish_sweep() gives the point its figures); the eye is the knob's, held to
-        // the exact eye.
-        if (set) watch(p, seq.base_shown, config.eye_substeps, *exact_seen, eye, options.repeats);
+        // The decoder is the base's (finish_sweep() gives the point its figures); the eye (or its LC) is the
+        // knob's, held to the exact eye (or the reference LC).
+        if (set && knob.lc_model) {
+          watch(p, seq.base_shown, config.eye_substeps, *lc_reference_seen, eye_of(config.decoder.decoder.panel),
+                options.repeats);
+        } else if (set) {
+          watch(p, seq.base_shown, config.eye_substeps, *exact_seen, eye, options.repeats);
+        }
         p.is_default = value == kr.default_value;
       } else {
         if (set) p = evaluate(config, seq, eye, options, sequence_done);

@@ -4,9 +4,10 @@
 // error, the perceived sequence (sweep_perceived.hpp) against the reference's seen by the same eye, decode time per
 // frame, and the on-chip / off-chip memory of FixedStreamingDecoder::report(). An eye-model knob's point watches the
 // base decoder's output with the knob's value against the reference decoder's seen by the exact eye
-// (kExactEyeSubsteps): perceived error and eye-model time per frame. The linear-resample-space knobs sweep around a
-// base of their own in that space when the run's space is the encoded one. The points are written out by
-// sweep_report.hpp.
+// (kExactEyeSubsteps): perceived error and eye-model time per frame; the LCD's LC model (lc_model) is held instead
+// to the same output through the reference LC at the same eye, so that its points differ in the LC alone. The
+// linear-resample-space knobs sweep around a base of their own in that space when the run's space is the encoded
+// one. The points are written out by sweep_report.hpp.
 #pragma once
 
 #include "pipeline.hpp"
@@ -45,10 +46,32 @@ struct SweepKnob {
   bool lcd = true;          // used with the LCD panel
   bool linear_space_only = false;  // used when D and U act in linear light: swept around a linear-space base
   bool eye_model = false;          // sets the eye model, not the decoder: the base decoder's output is watched
+  // An eye-model knob that sets the panel's liquid-crystal model (lc_model_names()): its points are held to the base
+  // decoder's output through the reference LC (kLcModelReference) at the base eye, not to the exact eye.
+  bool lc_model = false;
+  // The values' names when the knob is an index (value i is value_names[i]); empty: the values are numbers.
+  std::vector<std::string> value_names;
   std::function<int(const SweepConfig&)> get;
   // Sets the knob on a copy of the base configuration; may throw std::invalid_argument (the point is rejected).
   std::function<void(SweepConfig&, int)> set;
+
+  // How the reports write `value`: its name, or the number.
+  std::string value_label(int value) const;
 };
+
+// The LCD's liquid-crystal models of the eye's light, the `lc_model` knob's values: the first-order response
+// (LcdPanel::lc_response) and the second-order one (lc_second_order: the preset's, or the defaults of
+// LcSecondOrderParams), each without and with the panel's overdrive.
+const std::vector<std::string>& lc_model_names();
+// The reference every other is held to: second order with overdrive, the model with the most state (the crystal's
+// level and its rate: inertia as well as viscosity) and the panel's compensation computed from that state. It is not
+// a superset of the first order, whose rise τ_on depends on the drive where the second order has one τ and ζ for
+// every transition: a first-order point measures another crystal as much as a coarser one.
+inline constexpr int kLcModelReference = 3;
+// The model of a panel's LC, and the panel with another (throws std::invalid_argument for a value outside
+// lc_model_names()).
+int lc_model_of(const LcdPanel& lcd);
+void set_lc_model(LcdPanel& lcd, int model);
 
 // Every knob, in pipeline order.
 const std::vector<SweepKnob>& sweep_knobs();

@@ -73,9 +73,16 @@ std::string md_cell(const std::string& text) {
   return out;
 }
 
-std::string value_text(const SweepPoint& p) {
-  if (!p.is_default) return std::to_string(p.value);
-  return std::string("**").append(std::to_string(p.value)).append("** (base)");
+std::string value_text(const SweepKnob& k, const SweepPoint& p) {
+  const std::string label = k.value_names.empty() ? std::to_string(p.value)
+                                                  : std::to_string(p.value) + " " + k.value_label(p.value);
+  if (!p.is_default) return label;
+  return std::string("**").append(label).append("** (base)");
+}
+
+// What an eye-model knob's visual difference is measured against.
+std::string eye_reference_text(const SweepKnob& k) {
+  return k.lc_model ? k.value_label(kLcModelReference) : std::string("the exact eye");
 }
 
 std::string source_text(const SweepOptions& o) {
@@ -110,12 +117,21 @@ struct Candidate {
   const SweepPoint* point = nullptr;
 };
 
-// Accepted points of the decoder knobs swept in `space` (the base once) or of the eye-model knobs.
-std::vector<Candidate> candidates(const SweepResult& r, bool eye_model, ResampleSpace space) {
+// The knobs of one front: the decoder's, the eye model's held to the exact eye, and the LC model's, each against its
+// own reference (a front across references would set a point that is its own reference, 0, beside another's error).
+enum class KnobKind { Decoder, ExactEye, LcModel };
+
+KnobKind kind_of(const SweepKnob& k) {
+  return k.lc_model ? KnobKind::LcModel : k.eye_model ? KnobKind::ExactEye : KnobKind::Decoder;
+}
+
+// Accepted points of the knobs of one kind swept in `space` (the decoder's base once).
+std::vector<Candidate> candidates(const SweepResult& r, KnobKind kind, ResampleSpace space) {
   std::vector<Candidate> out;
   bool base_taken = false;
+  const bool eye_model = kind != KnobKind::Decoder;
   for (const auto& k : r.knobs) {
-    if (!k.skipped.empty() || k.knob->eye_model != eye_model || k.resample_space != space) continue;
+    if (!k.skipped.empty() || kind_of(*k.knob) != kind || k.resample_space != space) continue;
     for (const auto& p : k.points) {
       if (!p.ok()) continue;
       if (p.is_default && !eye_model) {
@@ -152,26 +168,34 @@ Front make_front(std::string name, std::string cost_label, std::string cost_unit
 
 double total_kib(const SweepPoint& p) { return static_cast<double>(p.on_chip_bits + p.off_chip_bits) / 8.0 / 1024.0; }
 
-// The three fronts of the run: decoder error against decode time and against memory, eye-model error against its
-// time.
+// The fronts of the run: decoder error against decode time and against memory, eye-model error against its time,
+// and (when the LC model was swept) the LC model's error against the eye-model time.
 std::vector<Front> fronts(const SweepResult& r) {
   const ResampleSpace space = r.options.pipeline.encoder.resample_space;
-  const auto decoder = candidates(r, false, space);
+  const auto decoder = candidates(r, KnobKind::Decoder, space);
   const auto mean_lsb = [](const SweepPoint& p) { return p.mean_lsb; };
-  return {make_front("decoder: error vs decode time", "decode time per view, ms (fastest of the repeats)",
-                     "ms/view", "mean |d| vs reference (output LSB)", decoder,
-                     [](const SweepPoint& p) { return p.min_seconds_per_frame * 1e3; }, mean_lsb),
-          make_front("decoder: error vs memory", "on + off chip memory (KiB)", "KiB",
-                     "mean |d| vs reference (output LSB)",
-                     decoder, total_kib, mean_lsb),
-          make_front("eye model: error vs run time", "eye-model time per frame, ms", "ms/frame",
-                     "visual difference vs the exact eye", candidates(r, true, space),
-                     [](const SweepPoint& p) { return p.eye_seconds_per_frame * 1e3; },
-                     [](const SweepPoint& p) { return p.visual_difference; })};
+  const auto eye_ms = [](const SweepPoint& p) { return p.eye_seconds_per_frame * 1e3; };
+  const auto visual_difference = [](const SweepPoint& p) { return p.visual_difference; };
+  std::vector<Front> out = {
+      make_front("decoder: error vs decode time", "decode time per view, ms (fastest of the repeats)", "ms/view",
+                 "mean |d| vs reference (output LSB)", decoder,
+                 [](const SweepPoint& p) { return p.min_seconds_per_frame * 1e3; }, mean_lsb),
+      make_front("decoder: error vs memory", "on + off chip memory (KiB)", "KiB", "mean |d| vs reference (output LSB)",
+                 decoder, total_kib, mean_lsb),
+      make_front("eye model: error vs run time", "eye-model time per frame, ms", "ms/frame",
+                 "visual difference vs the exact eye", candidates(r, KnobKind::ExactEye, space), eye_ms,
+                 visual_difference)};
+  std::vector<Candidate> lc = candidates(r, KnobKind::LcModel, space);
+  if (!lc.empty()) {
+    const std::string error_label = "visual difference vs " + eye_reference_text(*lc.front().knob->knob);
+    out.push_back(make_front("LC model: error vs eye-model time", "eye-model time per frame, ms", "ms/frame",
+                             error_label, std::move(lc), eye_ms, visual_difference));
+  }
+  return out;
 }
 
 std::string candidate_name(const Candidate& c) {
-  return c.knob->knob->name + " " + std::to_string(c.point->value) + (c.point->is_default ? " (base)" : "");
+  return c.knob->knob->name + " " + c.knob->knob->value_label(c.point->value) + (c.point->is_default ? " (base)" : "");
 }
 
 std::string pareto_table_md(const SweepResult& r) {
@@ -196,11 +220,12 @@ std::string pareto_table_md(const SweepResult& r) {
 
 std::string sweep_csv(const SweepResult& r) {
   const std::vector<std::string> columns = {
-      "knob", "resample_space", "value", "is_default", "status", "message", "identical_percent", "differing_codes",
-      "codes", "max_lsb", "mean_lsb", "rms_lsb", "linear_max", "linear_rms", "drive_max_lsb", "perceived_psnr_db",
-      "visual_difference", "residual_saturated", "residual_rounded", "seconds_per_frame", "min_seconds_per_frame",
-      "reference_seconds_per_frame", "setup_seconds", "eye_seconds_per_frame", "on_chip_bits", "off_chip_bits",
-      "delta_on_chip_bits", "delta_off_chip_bits", "residual_format", "meets_criterion"};
+      "knob", "resample_space", "value", "value_label", "is_default", "status", "message", "identical_percent",
+      "differing_codes", "codes", "max_lsb", "mean_lsb", "rms_lsb", "linear_max", "linear_rms", "drive_max_lsb",
+      "perceived_psnr_db", "visual_difference", "residual_saturated", "residual_rounded", "seconds_per_frame",
+      "min_seconds_per_frame", "reference_seconds_per_frame", "setup_seconds", "eye_seconds_per_frame",
+      "on_chip_bits", "off_chip_bits", "delta_on_chip_bits", "delta_off_chip_bits", "residual_format",
+      "meets_criterion"};
   std::ostringstream s;
   const auto row = [&s](const std::vector<std::string>& fields) {
     for (std::size_t i = 0; i < fields.size(); ++i) s << (i ? "," : "") << csv_field(fields[i]);
@@ -210,7 +235,7 @@ std::string sweep_csv(const SweepResult& r) {
   for (const auto& k : r.knobs) {
     for (const auto& p : k.points) {
       std::vector<std::string> f = {k.knob->name, trm::to_string(k.resample_space), std::to_string(p.value),
-                                    p.is_default ? "1" : "0", p.status, p.message};
+                                    k.knob->value_label(p.value), p.is_default ? "1" : "0", p.status, p.message};
       if (p.ok()) {
         for (const std::string& v :
              {general(p.identical_percent), std::to_string(p.differing), std::to_string(p.codes), general(p.max_lsb),
@@ -290,8 +315,11 @@ std::string sweep_markdown(const SweepResult& r) {
        "energy (supplement Eqs. 1–4) of the x–t image of row " << r.scan_line << " in the target's frame. Decoder "
        "knobs: against the reference decoder's sequence seen by the same eye (" << kDefaultRetinaSubsteps
     << " sub-steps); eye-model knobs: the base decoder watched with the knob's value, against the reference "
-       "decoder's sequence seen by the exact eye (" << kExactEyeSubsteps << " sub-steps); eye ms/frame: that eye "
-       "model's time per frame watched\n";
+       "decoder's sequence seen by the exact eye (" << kExactEyeSubsteps << " sub-steps); the LCD's LC model "
+       "(`lc_model`): the base decoder's sequence through each LC model, against the same sequence through the "
+       "reference LC (" << lc_model_names()[kLcModelReference] << "), both at the base eye (" << kDefaultRetinaSubsteps
+    << " sub-steps), so a point differs from its reference in the LC alone; eye ms/frame: that eye model's time "
+       "per frame watched\n";
   if (r.linear_base) {
     s << "* linear-resample-space knobs: swept around a base of their own, the same options with "
          "`--resample-space linear` (its own sequence and reference): base "
@@ -315,7 +343,7 @@ std::string sweep_markdown(const SweepResult& r) {
          "| ms/frame | min ms | eye ms/frame | on-chip KiB | off-chip KiB | Δ memory KiB | meets |\n"
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& p : k.points) {
-      s << "| " << value_text(p) << " | ";
+      s << "| " << value_text(*k.knob, p) << " | ";
       if (!p.ok()) {
         s << p.status << ": " << md_cell(p.message) << " | | | | | | | | | | | | | | | |\n";
         continue;
@@ -357,9 +385,11 @@ Json sweep_json(const SweepResult& r) {
   j["criterion"] = {{"identical_percent_at_least", kReferenceAgreementCriterion.min_identical_percent()},
                     {"max_lsb_at_most", kReferenceAgreementCriterion.max_lsb}};
   j["reference_seconds_per_frame"] = r.reference_seconds_per_frame;
-  const auto point_json = [&](const SweepPoint& p) {
+  // A knob's point (`knob` set: an index knob's points carry their value's name) or a base point.
+  const auto point_json = [&](const SweepPoint& p, const SweepKnob* knob) {
     Json pj;
     pj["value"] = p.value;
+    if (knob && !knob->value_names.empty()) pj["value_label"] = knob->value_label(p.value);
     pj["is_default"] = p.is_default;
     pj["status"] = p.status;
     if (!p.ok()) {
@@ -397,14 +427,17 @@ Json sweep_json(const SweepResult& r) {
               {"eye_velocity_deg_s", r.eye_velocity_deg_s},
               {"scan_line", r.scan_line},
               {"substeps", kDefaultRetinaSubsteps},
-              {"exact_substeps", kExactEyeSubsteps}};
-  j["base"] = point_json(r.base);
-  if (r.linear_base) j["linear_base"] = point_json(*r.linear_base);
+              {"exact_substeps", kExactEyeSubsteps},
+              {"lc_model_reference", lc_model_names()[kLcModelReference]}};
+  j["base"] = point_json(r.base, nullptr);
+  if (r.linear_base) j["linear_base"] = point_json(*r.linear_base, nullptr);
   Json pareto = Json::array();
   for (const Front& f : fronts(r)) {
     Json points = Json::array();
     for (std::size_t i : f.front) {
-      points.push_back({{"knob", f.points[i].knob->knob->name}, {"value", f.points[i].point->value},
+      const SweepKnob& knob = *f.points[i].knob->knob;
+      points.push_back({{"knob", knob.name}, {"value", f.points[i].point->value},
+                        {"value_label", knob.value_label(f.points[i].point->value)},
                         {"is_default", f.points[i].point->is_default}, {"cost", f.cost[i]}, {"error", f.error[i]}});
     }
     pareto.push_back({{"chart", f.name}, {"cost", f.cost_label}, {"error", f.error_label}, {"front", points}});
@@ -425,7 +458,7 @@ Json sweep_json(const SweepResult& r) {
       const SweepPoint* c = k.cheapest_meeting();
       kj["cheapest_meeting_criterion"] = c ? Json(c->value) : Json(nullptr);
       Json points = Json::array();
-      for (const auto& p : k.points) points.push_back(point_json(p));
+      for (const auto& p : k.points) points.push_back(point_json(p, k.knob));
       kj["points"] = std::move(points);
     }
     knobs.push_back(std::move(kj));
@@ -481,7 +514,7 @@ void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, c
     max_lsb.push_back(p->max_lsb);
     rms_lsb.push_back(p->rms_lsb);
     mean_lsb.push_back(p->mean_lsb);
-    labels.push_back(std::to_string(p->value));
+    labels.push_back(k.knob->value_label(p->value));
   }
   const std::string memory_label = on_varies && off_varies ? "on + off chip memory (KiB)"
                                    : off_varies            ? "off-chip memory (KiB)"
@@ -501,7 +534,7 @@ void write_sweep_plot(const std::filesystem::path& path, const SweepResult& r, c
     plot::Chart c;
     c.title = std::move(title);
     c.x = std::move(x_axis);
-    c.y.label = eye ? "visual difference vs the exact eye, 0 on the lower edge"
+    c.y.label = eye ? "visual difference vs " + eye_reference_text(*k.knob) + ", 0 on the lower edge"
                     : "error vs reference (output LSB), 0 on the lower edge";
     c.y.scale = plot::Scale::Log;
     c.y.nonpositive_on_edge = true;
@@ -552,13 +585,14 @@ std::vector<std::size_t> pareto_front(const std::vector<double>& cost, const std
 
 void write_pareto_plot(const std::filesystem::path& path, const SweepResult& r) {
   plot::Figure figure;
-  figure.width = 1800;
+  const std::vector<Front> all = fronts(r);
+  figure.width = 600 * static_cast<int>(all.size());
   figure.height = 560;
   figure.title = "Pareto fronts: error against run time and memory, every knob swept alone";
   figure.subtitle = header_line(r);
   figure.subtitle.append("; memory at ").append(std::to_string(r.options.hw_size.width)).append("x").append(
       std::to_string(r.options.hw_size.height));
-  for (const Front& f : fronts(r)) {
+  for (const Front& f : all) {
     plot::Chart chart;
     chart.title = f.name;
     chart.y.label = f.error_label + ", 0 on the lower edge";
@@ -618,9 +652,9 @@ std::string sweep_summary(const SweepResult& r) {
       continue;
     }
     if (k.knob->eye_model) {
-      s << "   eye model (base decoder): visual difference vs the exact eye";
+      s << "   eye model (base decoder): visual difference vs " << eye_reference_text(*k.knob);
       for (const SweepPoint& p : k.points) {
-        if (p.ok()) s << " " << p.value << ":" << scientific(p.visual_difference);
+        if (p.ok()) s << " " << k.knob->value_label(p.value) << ":" << scientific(p.visual_difference);
       }
       s << "\n";
       continue;

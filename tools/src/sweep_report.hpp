@@ -13,7 +13,7 @@
 
 namespace trm::cli {
 
-// sweep.csv: a header and one row per knob x value.
+// sweep.csv: a header and one row per knob x value (value_label: an index knob's value by name, else the number).
 std::string sweep_csv(const SweepResult& result);
 // sweep.md: parameters, a summary per knob, then one table per knob (the base value marked).
 std::string sweep_markdown(const SweepResult& result);
@@ -25,7 +25,9 @@ Json sweep_parameters_json(const SweepResult& result);
 // difference against the eye-model time).
 void write_sweep_plot(const std::filesystem::path& path, const SweepResult& result, const SweepKnobResult& knob);
 // sweep_pareto.png: the decoder knobs' mean code error against decode time and against memory, the eye-model knobs'
-// visual difference against eye-model time; each chart marks its Pareto front and the default point.
+// visual difference against eye-model time, and when it was swept the LC model's against eye-model time (a chart of
+// its own: its reference is the second-order overdriven LC, not the exact eye); each chart marks its Pareto front
+// and the default point.
 void write_pareto_plot(const std::filesystem::path& path, const SweepResult& result);
 // The indices of the points on the Pareto front of (cost, error), both minimised: those no other point beats with
 // cost <= and error <= and one of them <. Ascending cost; equal points are all on it. Throws std::invalid_argument

@@ -33,6 +33,7 @@ struct LcResponseParams {
   double tau_off_s = 0.002;         // > 0 and finite: falling (elastic) time constant
   double drive_ratio = 3.0;         // V_max / V_th, > 1 and finite
   double drive_gamma = 2.2;         // γ_d: level p ↔ drive code p^(1/γ_d), in [0.5, 4]
+  friend bool operator==(const LcResponseParams&, const LcResponseParams&) = default;
 };
 
 // One frame's segment of the ODE: the level the LC relaxes toward and its time constant.

@@ -12,6 +12,7 @@
 #include <nlohmann/json_fwd.hpp>
 #include <opencv2/core.hpp>
 
+#include "trm/lc_response.hpp"
 #include "trm/lc_second_order.hpp"
 
 #include <array>
@@ -48,8 +49,11 @@ struct OledPanel {
 struct LcdPanel {
   double p1 = -0.1, p2 = 0.2, p3 = 0.5, p4 = 0.0;  // defaults satisfy M(v, v) = v (p4 = 0, p3 = 1/2, p2 = -2 p1)
   double gamma = 2.2;
-  // The liquid crystal of the eye model's light (panel_light.hpp): unset, the level-dependent first-order response;
-  // set, the second-order system (damping_ratio >= kMinPanelDampingRatio). The drive (Eq. 7) does not depend on it.
+  // The liquid crystal of the eye model's light (panel_light.hpp): the level-dependent first-order response with
+  // lc_response's parameters, or, when lc_second_order is set, the second-order system (damping_ratio >=
+  // kMinPanelDampingRatio; lc_response then stays at its defaults: one LC model). The drive (Eq. 7) depends on
+  // neither.
+  LcResponseParams lc_response;
   std::optional<LcSecondOrderParams> lc_second_order;
   // The panel overdrives its liquid crystal (panel_light.hpp, PanelLightConfig::overdrive): the eye model's light
   // reaches each frame's level within the frame where the drive range allows. The drive (Eq. 7) does not depend on it.
@@ -141,8 +145,9 @@ inline constexpr double kMaxLcdCoefficient = 16.0;
 // The physical rules a panel must meet for its drive to be an inverse (one validation for every decoder): OLED gammas
 // and LCD gamma within [kMinPanelGamma, kMaxPanelGamma], OLED duty in (0, 1], LCD coefficients finite and within
 // kMaxLcdCoefficient, M(v_t, v_prev) strictly increasing in v_t on [0, 1]^2 and the held merge M(v, v) strictly
-// increasing on [0, 1] (otherwise several drives give one light and the inverse is not defined). Throws
-// std::invalid_argument with `what` and the rule.
+// increasing on [0, 1] (otherwise several drives give one light and the inverse is not defined); and for the eye
+// model's light, the LCD's LC parameters within their models' ranges (LcResponse, LcSecondOrder; damping_ratio >=
+// kMinPanelDampingRatio) with one LC model set. Throws std::invalid_argument with `what` and the rule.
 void validate_panel(const Panel& panel, const std::string& what);
 
 // "vive" | "rift" | "generic" | "gamma:G" | "gamma:GR,GG,GB" | "lcd" | "lcd:p1,p2,p3,p4,gamma" | "lcd:FILE.json"
@@ -152,14 +157,16 @@ void validate_panel(const Panel& panel, const std::string& what);
 Panel parse_panel(const std::string& spec);
 
 // The panel as JSON, every parameter of its kind: {"kind": "oled", "name", "gamma": [R, G, B], "duty"} or
-// {"kind": "lcd", "name", "p1", "p2", "p3", "p4", "gamma"}, and with a second-order liquid crystal
-// "lc_second_order": {"tau_s", "damping_ratio"} (absent without one), with overdrive "overdrive": true (absent
-// without). The one writer and the one reader of a panel, for both
-// JSON flavours the reports use (one body each).
+// {"kind": "lcd", "name", "p1", "p2", "p3", "p4", "gamma"}, and with first-order LC parameters other than the
+// defaults "lc_response": {"tau_off_s", "drive_ratio", "drive_gamma"} (absent at the defaults), with a second-order
+// liquid crystal "lc_second_order": {"tau_s", "damping_ratio"} (absent without one), with overdrive "overdrive": true
+// (absent without). The one writer and the one reader of a panel, for both JSON flavours the reports use (one body
+// each).
 void to_json(nlohmann::json& out, const Panel& panel);
 void to_json(nlohmann::ordered_json& out, const Panel& panel);
 // Throws std::invalid_argument "panel JSON: ..." for a missing or mistyped field (an "overdrive" that is not a
-// boolean), an unknown kind or a panel that breaks validate_panel's rules.
+// boolean), a field the kind does not take (named, with the ones it takes: a misspelt field is an error, not a
+// default), an unknown kind or a panel that breaks validate_panel's rules.
 void from_json(const nlohmann::json& in, Panel& panel);
 void from_json(const nlohmann::ordered_json& in, Panel& panel);
 

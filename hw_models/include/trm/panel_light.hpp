@@ -72,13 +72,12 @@ struct PanelLightConfig {
 inline constexpr double kViveOledDuty = 0.2;
 
 // The constant τ of a first-order response with one time constant for every transition: 2 ms, the falling τ_off of
-// LcResponseParams. LCD panels use the level-dependent response (PanelLightOptions::lc_response) instead.
+// LcResponseParams. LCD panels use the level-dependent response (their preset's LcdPanel::lc_response) instead.
 inline constexpr double kDefaultLcdTauS = 0.002;
 
 // Options for the light of a Panel (panel_light): what the drive model does not know.
 struct PanelLightOptions {
   ScanOut scan_out = ScanOut::Global;
-  LcResponseParams lc_response;       // LCD only: the level-dependent LC response
   double strobe_duty = 1.0;           // LCD only: backlight window (1: always on)
   // LCD only: strobe window start as a fraction of the frame; negative means at the end of the frame (1 − duty),
   // where the liquid crystal has settled most, as strobed backlights place it.
@@ -154,9 +153,9 @@ class PanelLight {
 };
 
 // The light of `panel` at `refresh_hz`: an OLED emits for panel.oled.duty of the frame from its start with no LC
-// response; an LCD holds (or strobes) with the level-dependent LC response options.lc_response, or with the
-// second-order LC when its preset has one (panel.lcd.lc_second_order, which then replaces options.lc_response), and
-// overdrives it when the preset says so (panel.lcd.overdrive). Throws std::invalid_argument naming the argument.
+// response; an LCD holds (or strobes) with its preset's LC: the level-dependent response panel.lcd.lc_response, or
+// the second-order LC when the preset has one (panel.lcd.lc_second_order), overdriven when the preset says so
+// (panel.lcd.overdrive). Throws std::invalid_argument naming the argument.
 PanelLight panel_light(const Panel& panel, double refresh_hz, const PanelLightOptions& options = {});
 
 // The steady level drive v holds on `panel` (channel c): OLED v^gamma_c, LCD M(v, v)^gamma. What a frame's drive
