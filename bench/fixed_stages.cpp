@@ -219,12 +219,17 @@ void BM_LcdDrive(benchmark::State& state) {
 }
 BENCHMARK(BM_LcdDrive)->Arg(0)->Arg(1);
 
+// Printed once in the context block: the instruction set the line kernels dispatch to.
+const bool kLineKernelContext = [] {
+  benchmark::AddCustomContext("line kernels", trm::fixed_detail::lines::target_name());
+  return true;
+}();
+
 // The line kernels: U's column blend of two reduced rows and the row blend with the EOTF (one output line of L or
 // alpha, the column blends not cached), Eq. 2's split, Eqs. 5-6 per pixel, Eq. 4 and the OLED drive codes.
 void BM_LineUpsampleEotf(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
-  benchmark::AddCustomContext("line kernels", trm::fixed_detail::lines::target_name());
   const std::vector<std::uint16_t> row0 = random_codes(3 * g.reduced.width, kernels.max_code(), 2);
   const std::vector<std::uint16_t> row1 = random_codes(3 * g.reduced.width, kernels.max_code(), 3);
   const auto n = static_cast<std::size_t>(3 * kWidth);
