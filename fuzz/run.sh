@@ -48,7 +48,7 @@ header_dirs=("$root/link/include" "$root/link/src" "$root/encoder/include" "$roo
 # The library sources the targets reach, instrumented for coverage (fuzzer-no-link) and the sanitizers,
 # compiled TRM_FUZZ_JOBS at a time and rebuilt when a source or a project header is newer.
 sources=("$root"/link/src/*.cpp "$root"/encoder/src/{frame,transfer,sources}.cpp "$root"/encoder/src/scenes/scene_support.cpp
-         "$root"/hw_models/src/panel.cpp "$root"/hw_models/src/lc_second_order.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp)
+         "$root"/hw_models/src/panel.cpp "$root"/hw_models/src/lc_response.cpp "$root"/hw_models/src/lc_second_order.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp)
 compile() {  # SOURCE OBJECT HEADER_DIR... -- FLAGS...
   local src=$1 obj=$2 dirs=()
   shift 2
