@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -306,5 +307,28 @@ void BM_LineOledDriveCodes(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
 BENCHMARK(BM_LineOledDriveCodes);
+
+// The LCD drive over a line after the eye's first frame, with its frame-store update (the stores are rewritten each
+// iteration from the same random history, outside the timing).
+void BM_LineLcdDrive(benchmark::State& state) {
+  FixedKernels kernels(config_of("lcd"));
+  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 13);
+  const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 14);
+  const std::vector<std::uint16_t> previous_codes = random_codes(3 * kWidth, kernels.max_output_code(), 15);
+  std::vector<std::int32_t> store_linear(previous.size());
+  std::vector<std::uint16_t> store_codes(previous_codes.size()), codes(wanted.size());
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::copy(previous.begin(), previous.end(), store_linear.begin());
+    std::copy(previous_codes.begin(), previous_codes.end(), store_codes.begin());
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(trm::fixed_detail::lines::lcd_drive(wanted.data(), wanted.size(), *kernels.line_plans().lcd,
+                                                                 kernels, store_codes.data(), store_linear.data(),
+                                                                 codes.data(), nullptr));
+    benchmark::DoNotOptimize(codes.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineLcdDrive);
 
 }  // namespace

@@ -151,7 +151,10 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   const auto n = static_cast<std::size_t>(samples);
   scratch.first.resize(n);
   upsample(low0, low1, g, y, scratch.first.data(), grey, scratch.first_rows);  // L_t
-  if (lost || !line_kernels(out)) {
+  const FixedLinePlans& plans = kernels_.line_plans();
+  // An LCD line after the eye's first frame: its drive over the line too, whose shortfall joins rho (Sec. 4.4).
+  const bool lcd_line = !line_kernels(out) && line_values(out) && plans.lcd && !out.lcd_held;
+  if (lost || !(line_kernels(out) || lcd_line)) {
     for (int x = 0; x < g.full.width; ++x) {
       full_pixel(out, eye, y, x, codes_row, scratch.first.data() + 3 * x, residual_row, lost, grey);
     }
@@ -161,14 +164,22 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   // store, whose rounding and saturation act only where rho is not zero.
   scratch.shown.resize(n);
   scratch.rho.resize(n);
-  const FixedLinePlans& plans = kernels_.line_plans();
   const std::uint64_t clipped = lines::compensate(codes_row, scratch.first.data(), n, plans.code_rom.data(), plans.one,
                                                   scratch.shown.data(), scratch.rho.data());
   FrameTally& t = out.tally;
   t.clipped += clipped;
   t.counts.beta_clipped += clipped;
-  lines::drive_codes(scratch.shown.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
-  const Raw* rho = scratch.rho.data();
+  Raw* rho = scratch.rho.data();
+  if (lcd_line) {
+    scratch.shortfall.resize(n);
+    t.counts.lcd_unreachable +=
+        lines::lcd_drive(scratch.shown.data(), n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint16_t>(y),
+                         eye.lcd_previous_linear.ptr<std::int32_t>(y), out.frame.drive_codes.ptr<std::uint16_t>(y),
+                         scratch.shortfall.data());
+    for (std::size_t s = 0; s < n; ++s) rho[s] += scratch.shortfall[s];
+  } else {
+    lines::drive_codes(scratch.shown.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+  }
   for (std::size_t s = 0; s < n; ++s) {
     if (rho[s] == 0) {
       residual_row[s] = 0;
@@ -242,6 +253,14 @@ void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const R
   if (drive) {
     lines::drive_codes(shown, 3 * static_cast<std::size_t>(eye.full_size.width), *drive,
                        out.frame.drive_codes.ptr<std::uint16_t>(y));
+    return;
+  }
+  const std::optional<LcdPlan>& lcd = kernels_.line_plans().lcd;
+  if (lcd && !out.lcd_held) {
+    out.tally.counts.lcd_unreachable +=
+        lines::lcd_drive(shown, 3 * static_cast<std::size_t>(eye.full_size.width), *lcd, kernels_,
+                         eye.lcd_previous_drive.ptr<std::uint16_t>(y), eye.lcd_previous_linear.ptr<std::int32_t>(y),
+                         out.frame.drive_codes.ptr<std::uint16_t>(y), nullptr);
     return;
   }
   for (int x = 0; x < eye.full_size.width; ++x) {

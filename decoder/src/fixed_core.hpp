@@ -105,6 +105,7 @@ struct LineScratch {
   std::vector<Raw> shown;        // the line's emitted linear values
   std::vector<Raw> rho;          // a full frame's beta - shown
   std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
+  std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho)
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.

@@ -266,6 +266,100 @@ void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, 
   }
 }
 
+// One sample of the LCD drive by the stage function, with emit's frame-store update.
+inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const FixedKernels& kernels,
+                                std::uint16_t& previous_code, std::int32_t& previous_linear, std::int64_t* shortfall,
+                                std::uint64_t& unreachable) {
+  const LcdSample sample = kernels.lcd_drive(wanted, previous_linear, previous_code, false, false);
+  unreachable += sample.unreachable ? 1 : 0;
+  if (shortfall != nullptr) *shortfall = sample.shortfall;
+  previous_code = sample.code;
+  previous_linear = static_cast<std::int32_t>(p.contributed ? sample.contributed : wanted);
+  return sample.code;
+}
+
+std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                       std::uint16_t* previous_code, std::int32_t* previous_linear, std::uint16_t* codes,
+                       std::int64_t* shortfall) {
+  std::uint64_t unreachable = 0;
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Repartition<std::int32_t, decltype(d)> di32;
+  const hn::Rebind<std::int32_t, decltype(d)> d32;
+  const hn::Rebind<std::uint32_t, decltype(du)> du32h;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const hn::Rebind<double, decltype(d)> df;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto unit = hn::Set(d, std::int64_t{1});
+  const auto one = hn::Set(d, p.one);
+  const auto full_sum = hn::Set(d, std::int64_t{1} << (p.linear_frac_bits + 1));
+  const auto bottom_bits = hn::Set(d, std::int64_t{p.bottom_region_bits});
+  const auto scale = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.scale}));
+  const auto top = hn::Set(d, std::int64_t{p.top});
+  const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
+  const auto exponent_bias = hn::Set(d, std::int64_t{1023});
+  for (; s + lanes <= n; s += lanes) {
+    const auto x = hn::LoadU(d, wanted + s);
+    const auto x_previous = hn::PromoteTo(d, hn::LoadU(d32, previous_linear + s));
+    const auto j = hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d16, previous_code + s))));
+    const auto sum = hn::Add(x, x_previous);
+    // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one.
+    // (A sum of 2 or more reads 1, not the ROM: its code is clamped as evaluate_raw clamps it.)
+    const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), p.target_shift), top_code);
+    const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
+    const auto bottom = hn::Lt(lead, bottom_bits);
+    const auto scale_bits = hn::IfThenElse(bottom, bottom_bits, lead);
+    const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
+    const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
+    const auto scaled = hn::ShiftLeftSame(offset, p.segments_per_octave_log2);
+    const auto node = hn::Add(hn::ShiftLeftSame(region, p.segments_per_octave_log2), hn::Shr(scaled, scale_bits));
+    const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
+    const auto word = hn::GatherIndex(d, p.target_packed.data(), node);
+    const auto exact = hn::Add(hn::Shl(hn::ShiftRight<32>(word), scale_bits),
+                               hn::MulEven(hn::BitCast(di32, word), hn::BitCast(di32, weight)));
+    const auto rom_target = hn::Shr(hn::Add(exact, hn::Shl(unit, hn::Sub(scale_bits, unit))), scale_bits);
+    const auto target = hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
+    const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target), scale));
+    // The largest k with M(T_k, v_{t-1}) <= m, branch-free over the merge table's row.
+    const auto row = hn::ShiftLeftSame(j, p.width_log2);
+    auto lo = zero;
+    auto hi = top;
+    for (int i = 0; i < p.steps; ++i) {
+      const auto active = hn::Lt(lo, hi);
+      const auto mid = hn::ShiftRight<1>(hn::Add(hn::Add(lo, hi), unit));
+      const auto merge = hn::GatherIndex(d, p.merge.data(), hn::Add(row, hn::IfThenElse(active, mid, unit)));
+      const auto up = hn::And(active, hn::Not(hn::Lt(target_scaled, merge)));
+      const auto down = hn::AndNot(up, active);
+      lo = hn::IfThenElse(up, mid, lo);
+      hi = hn::IfThenElse(down, hn::Sub(mid, unit), hi);
+    }
+    const auto end_dark = hn::GatherIndex(d, p.end_dark.data(), j);
+    const auto end_bright = hn::GatherIndex(d, p.end_bright.data(), j);
+    const auto below = hn::Lt(sum, hn::Add(end_dark, end_dark));
+    const auto above = hn::Gt(sum, hn::Add(end_bright, end_bright));
+    const auto clamped = hn::Or(below, above);
+    const auto drive = hn::IfThenElse(clamped, hn::IfThenElseZero(above, top), lo);
+    const auto end = hn::IfThenElse(above, end_bright, end_dark);
+    const auto contributed = hn::IfThenElse(clamped, hn::Sub(hn::Add(end, end), x_previous), x);
+    unreachable += hn::CountTrue(d, clamped);
+    if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + s);
+    const auto stored = p.contributed ? contributed : x;
+    hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + s);
+    hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, previous_code + s);
+    hn::StoreU(hn::BitCast(d32, hn::TruncateTo(du32h, hn::BitCast(du, stored))), d32, previous_linear + s);
+  }
+#endif
+  for (; s < n; ++s) {
+    codes[s] = lcd_scalar(wanted[s], p, kernels, previous_code[s], previous_linear[s],
+                          shortfall != nullptr ? shortfall + s : nullptr, unreachable);
+  }
+  return unreachable;
+}
+
 // The motion weight of one pixel and Eq. 4 of one sample by the stage functions (tails and out-of-lane operands).
 inline std::int64_t weight_scalar(const std::int64_t* previous, const std::int64_t* alpha, const FixedKernels& kernels,
                                   MotionTally& tally) {
@@ -571,6 +665,43 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
       plans.gaussian = GaussianPlan{T - L, T + L};
     }
   }
+  if (kernels.lcd() && !kernels.lcd_merge_table_.empty() && kernels.lcd_target_lut_) {
+    const fx::InterpolatedLut& target = *kernels.lcd_target_lut_;
+    LcdPlan l;
+    l.linear_frac_bits = F;
+    l.one = kernels.one();
+    l.top = kernels.max_output_code();
+    l.width = l.top + 1;
+    while ((std::int64_t{1} << l.width_log2) < l.width) ++l.width_log2;
+    const auto scale = static_cast<std::uint64_t>(2 * l.top) * static_cast<std::uint64_t>(2 * l.top);
+    l.scale = static_cast<std::uint32_t>(scale);
+    l.target_shift = F + 1 - target.shape().input_bits;
+    l.target_input_bits = target.shape().input_bits;
+    l.bottom_region_bits = target.bottom_region_bits();
+    l.segments_per_octave_log2 = target.segments_per_octave_log2();
+    while ((1 << l.steps) < l.width) ++l.steps;
+    l.merge = kernels.lcd_merge_table_;
+    l.end_dark = kernels.lcd_end_luminance_[0];
+    l.end_bright = kernels.lcd_end_luminance_[1];
+    l.contributed = c.decoder.lcd_history == LcdHistory::Contributed;
+    const std::vector<std::int64_t>& rom = target.rom();
+    std::vector<std::int64_t> step(rom.size(), 0);
+    for (std::size_t i = 0; i + 1 < rom.size(); ++i) step[i] = rom[i + 1] - rom[i];
+    std::optional<std::vector<std::int64_t>> packed = packed_rom(rom, step);
+    // 32-bit operands for the target's scaling and the ROM weight (scale bits up to the ROM's 24 address bits), the
+    // octave nodes within the ROM, the merges of every (v_{t-1}, k) present.
+    const bool fits = packed && F <= 30 && (std::int64_t{1} << l.width_log2) == l.width && scale < (std::uint64_t{1} << 32) && l.target_shift >= 0 &&
+                      target.is_octave_segmented() && target.shape().rounding == fx::Quant::Rnd &&
+                      !target.shape().output_signed && target.shape().input_bits <= 30 && l.bottom_region_bits >= 1 &&
+                      rom.size() >= (static_cast<std::size_t>(target.shape().octaves) << l.segments_per_octave_log2) &&
+                      l.merge.size() >= static_cast<std::size_t>(l.width * l.width) &&
+                      l.end_dark.size() == static_cast<std::size_t>(l.width) &&
+                      l.end_bright.size() == static_cast<std::size_t>(l.width);
+    if (fits) {
+      l.target_packed = std::move(*packed);
+      plans.lcd = std::move(l);
+    }
+  }
   if (!kernels.lcd()) {
     DrivePlan d;
     d.mantissa_bits = ThresholdIndex::kMantissaBits;
@@ -648,6 +779,7 @@ HWY_EXPORT(DriveCodes);
 HWY_EXPORT(Compensate);
 HWY_EXPORT(GaussianColumns);
 HWY_EXPORT(GaussianRows);
+HWY_EXPORT(LcdDrive);
 HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(TargetName);
@@ -673,6 +805,11 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
                    int shift, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, out);
+}
+std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                        std::uint16_t* previous_code, std::int32_t* previous_linear, std::uint16_t* codes,
+                        std::int64_t* shortfall) {
+  return HWY_DYNAMIC_DISPATCH(LcdDrive)(wanted, n, plan, kernels, previous_code, previous_linear, codes, shortfall);
 }
 void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {

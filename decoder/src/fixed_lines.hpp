@@ -106,12 +106,35 @@ struct MotionTally {
   std::int64_t residual_abs_max = 0;
 };
 
+// The LCD drive (FixedKernels::lcd_drive after the eye's first frame, and emit's frame-store update): the target
+// m = ((x_t + x_{t-1}) / 2)^(1/gamma) through the octave-segmented ROM, the binary search over the merge table's row
+// v_{t-1}, and the unreachable ends.
+struct LcdPlan {
+  std::vector<std::int64_t> target_packed;  // the target ROM as EotfPlan::packed
+  int target_shift = 0;                     // the sum's bits below the ROM's input code
+  int target_input_bits = 0;
+  int bottom_region_bits = 0;
+  int segments_per_octave_log2 = 0;
+  int linear_frac_bits = 0;
+  std::int64_t one = 0;
+  std::uint32_t scale = 0;  // (2 Mx)^2: the target's scaling to the merge table's integers
+  std::vector<std::int64_t> merge;  // (2^o) rows of 2^o words: row v_{t-1}, column k
+  std::int64_t width = 0;           // 2^o
+  int width_log2 = 0;
+  int top = 0;                      // 2^o - 1
+  int steps = 0;                    // binary search steps that cover [0, top]
+  std::vector<std::int64_t> end_dark;    // M(0, v_{t-1})^gamma, uQ/sQ.F
+  std::vector<std::int64_t> end_bright;  // M(1, v_{t-1})^gamma
+  bool contributed = false;              // LcdHistory::Contributed: x_{t-1} stored is the contributed value
+};
+
 // What the line kernels need from a configuration, or nothing where its formats do not fit their lanes.
 struct FixedLinePlans {
   std::optional<EotfPlan> eotf;    // encoded-space U and EOTF (8-bit sums, W <= 24, 2W > U, interpolation on 64 bits)
   std::optional<DrivePlan> drive;  // OLED drive codes
   std::optional<MotionPlan> motion;  // finite, non-zero s; uniform reciprocal and exp ROMs with power-of-two steps
   std::optional<GaussianPlan> gaussian;  // encoded space, max_code 2^T and max_code 2^L below 2^32
+  std::optional<LcdPlan> lcd;            // LCD with the merge table (output codes up to 8 bits), F <= 30
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
   std::int64_t one = 0;
 
@@ -142,6 +165,13 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
 // D's vertical half: out[i] = round(sum_j weight[j] rows[j][i], T + L), half up, for i < n (rows[j][i] < 2^32).
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
                    int shift, std::uint16_t* out);
+// The LCD drive of n samples of one line after the eye's first frame: codes[s] and, where shortfall is not null,
+// shortfall[s] as FixedKernels::lcd_drive(wanted[s], previous_linear[s], previous_code[s], false) gives them, and
+// the frame stores previous_code / previous_linear replaced as FixedDecoderCore::emit replaces them. Returns the
+// number of unreachable samples.
+std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                        std::uint16_t* previous_code, std::int32_t* previous_linear, std::uint16_t* codes,
+                        std::int64_t* shortfall);
 // Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
 // whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions
 // of `kernels`.

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <random>
@@ -239,6 +240,71 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
   }
 }
 
+// The LCD drive kernel against FixedKernels::lcd_drive and emit's frame-store update, sample by sample: random wanted
+// and previous values (sums from 0 to past 2, so the target ROM's every octave, its bottom region and the clamp to
+// 1 are read), random v_{t-1}, both history modes (Contributed stores negative values after a dark shortfall), on
+// every instruction set.
+TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
+  // F = 20 besides the default: there one LSB of the target m moves a code often enough to be seen.
+  for (const auto& [history, linear_frac_bits] : {std::pair{LcdHistory::Wanted, 28}, std::pair{LcdHistory::Contributed, 28},
+                                                  std::pair{LcdHistory::Wanted, 20}}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
+    config.decoder.lcd_history = history;
+    config.linear_frac_bits = linear_frac_bits;
+    config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
+    const fixed_detail::FixedKernels kernels(config);
+    const auto& plan = kernels.line_plans().lcd;
+    ASSERT_TRUE(plan.has_value());
+    const std::int64_t one = kernels.one();
+    constexpr std::size_t kSamples = 3 * 20011;  // many, so that a target one LSB off crosses a merge threshold
+    std::mt19937_64 random(13);
+    std::uniform_int_distribution<std::int64_t> linear(0, one);
+    std::uniform_int_distribution<int> octave(0, linear_frac_bits);
+    std::vector<std::int64_t> wanted(kSamples);
+    std::vector<std::int32_t> previous_linear(kSamples);
+    std::vector<std::uint16_t> previous_code(kSamples);
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      // Every third sample small, spread over the octaves (down to the ROM's bottom region), others uniform.
+      wanted[s] = s % 3 == 0 ? (std::int64_t{1} << octave(random)) + (s % 7) : linear(random);
+      previous_linear[s] = static_cast<std::int32_t>(s % 5 == 0 ? -(linear(random) / 8) : linear(random));
+      if (s % 11 == 0) wanted[s] = previous_linear[s] = 0;
+      if (s % 13 == 0) wanted[s] = one, previous_linear[s] = static_cast<std::int32_t>(one);
+      previous_code[s] = static_cast<std::uint16_t>(random() % 256);
+    }
+    std::vector<std::uint16_t> expected_codes(kSamples), expected_store_code(previous_code);
+    std::vector<std::int32_t> expected_store_linear(previous_linear);
+    std::vector<std::int64_t> expected_shortfall(kSamples);
+    std::uint64_t expected_unreachable = 0;
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      const fixed_detail::LcdSample sample = kernels.lcd_drive(wanted[s], previous_linear[s], previous_code[s], false, false);
+      expected_codes[s] = sample.code;
+      expected_shortfall[s] = sample.shortfall;
+      expected_unreachable += sample.unreachable ? 1 : 0;
+      expected_store_code[s] = sample.code;
+      expected_store_linear[s] = static_cast<std::int32_t>(history == LcdHistory::Contributed ? sample.contributed : wanted[s]);
+    }
+    EXPECT_GT(expected_unreachable, 0u) << "the operands reach the unreachable ends";
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      const std::string where = std::string(hwy::TargetName(target)) +
+                                (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
+                                std::to_string(linear_frac_bits);
+      std::vector<std::uint16_t> store_code(previous_code), codes(kSamples);
+      std::vector<std::int32_t> store_linear(previous_linear);
+      std::vector<std::int64_t> shortfall(kSamples);
+      const std::uint64_t unreachable = fixed_detail::lines::lcd_drive(
+          wanted.data(), kSamples, *plan, kernels, store_code.data(), store_linear.data(), codes.data(), shortfall.data());
+      EXPECT_EQ(unreachable, expected_unreachable) << where;
+      for (std::size_t s = 0; s < kSamples; ++s) {
+        ASSERT_EQ(codes[s], expected_codes[s]) << where << " sample " << s << " wanted " << wanted[s];
+        ASSERT_EQ(shortfall[s], expected_shortfall[s]) << where << " sample " << s;
+        ASSERT_EQ(store_code[s], expected_store_code[s]) << where << " sample " << s;
+        ASSERT_EQ(store_linear[s], expected_store_linear[s]) << where << " sample " << s;
+      }
+    }
+  }
+}
+
 // The formats the kernels take: the defaults at an 8-bit link (U's sums in 32-bit lanes) and an OLED drive; a 10-bit
 // link's U sums exceed 32 bits and an LCD drive is the merge search, so those keep the per-sample steps.
 TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
@@ -259,6 +325,9 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   EXPECT_FALSE(plans_of(octave_exp).motion.has_value());
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).eotf.has_value());
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5), "lcd")).drive.has_value());
+  EXPECT_TRUE(plans_of(fixed_config(link_config(0.5), "lcd")).lcd.has_value());
+  EXPECT_FALSE(plans_of(fixed_config(link_config(0.5), "lcd", 10)).lcd.has_value()) << "no merge table at 10 bits";
+  EXPECT_FALSE(plans_of(oled).lcd.has_value());
   EXPECT_FALSE(plans_of(with_kernels(oled, false, true)).eotf.has_value());
   FixedDecoderConfig narrow_shift = oled;
   narrow_shift.bilinear_weight_frac_bits = 16;  // 2W = U: U's blend is not rounded, only padded

@@ -117,6 +117,10 @@ class InterpolatedLut {
   // K of the uniform mode (segment position per input code, kSegmentFracBits fraction bits): where it is 2^k, the
   // node is the code's top bits and the weight the rest shifted by k, which a caller may compute with shifts alone.
   std::uint64_t segment_step() const { return segment_step_; }
+  // The octave mode's layout (is_octave_segmented): log2 S and the bottom region's bits, for callers that compute
+  // evaluate_raw's node and weight themselves.
+  int segments_per_octave_log2() const { return segments_per_octave_log2_; }
+  int bottom_region_bits() const { return bottom_region_bits_; }
   bool is_octave_segmented() const { return shape_.octaves > 0 && !direct_; }
   const std::string& name() const { return name_; }
   const LutShape& shape() const { return shape_; }
