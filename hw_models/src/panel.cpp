@@ -1,6 +1,8 @@
 // Panel models (DESIGN §4 "Panel drive", paper Sec. 4.4) in double precision.
 #include "trm/panel.hpp"
 
+#include "perception_checks.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -17,6 +19,8 @@
 namespace trm {
 
 namespace {
+
+using perception_detail::number_text;  // shortest round-trip text of a number, for messages
 
 // Measured per-primary gammas (paper Sec. 4.4, Specbos 1211 measurements).
 constexpr std::array<double, 3> kViveGamma{2.2912, 2.2520, 2.1940};
@@ -46,12 +50,6 @@ std::string in_quotes(std::string_view text) {
   return out;
 }
 
-// Shortest round-trip text of a number, for messages.
-std::string number_text(double value) {
-  char text[32];
-  const auto [end, ec] = std::to_chars(text, text + sizeof text, value);
-  return ec == std::errc() ? std::string(text, end) : std::string("?");
-}
 
 std::string accepted_forms() {
   const std::string gammas = "within [" + number_text(kMinPanelGamma) + ", " + number_text(kMaxPanelGamma) + "]";
