@@ -241,14 +241,14 @@ class FixedDecoderCore {
   // and the cache where the plans allow, else FixedKernels::upsample_line.
   void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, Raw* out, bool grey,
                 ColumnBlendCache& cache) const;
-  // The line kernels take a whole line: OLED drive codes without report planes or taps (emit's other work).
+  // The line kernels take a whole line, the OLED drive included: no report planes or taps (emit's other work).
   bool line_kernels(const FrameOutput& out) const { return line_values(out) && kernels_.line_plans().drive; }
   // A reduced-frame line's shown values over the whole line, emitted afterwards (emit_line): any panel.
   bool line_values(const FrameOutput& out) const {
     return kernels_.line_plans().eotf && !config().report_planes && out.taps == nullptr;
   }
-  // The drive codes of a reduced-frame line's shown values: the OLED drive kernel, else emit per sample in raster
-  // order (the LCD's frame stores).
+  // The drive codes of a reduced-frame line's shown values: the OLED drive kernel, the LCD drive kernel after the
+  // eye's first view, else emit per sample in raster order (the LCD's frame stores).
   void emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown) const;
   void full_pixel(FrameOutput& out, EyeState& eye, int y, int x, const std::uint16_t* codes_row, const Raw* low,
                   std::int32_t* residual_row, bool lost, bool grey) const;
