@@ -324,7 +324,7 @@ void BM_LineLcdDrive(benchmark::State& state) {
     state.ResumeTiming();
     benchmark::DoNotOptimize(trm::fixed_detail::lines::lcd_drive(wanted.data(), wanted.size(), *kernels.line_plans().lcd,
                                                                  kernels, store_codes.data(), store_linear.data(),
-                                                                 codes.data(), nullptr));
+                                                                 false, codes.data(), nullptr));
     benchmark::DoNotOptimize(codes.data());
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);

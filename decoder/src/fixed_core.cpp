@@ -152,8 +152,8 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   scratch.first.resize(n);
   upsample(low0, low1, g, y, scratch.first.data(), grey, scratch.first_rows);  // L_t
   const FixedLinePlans& plans = kernels_.line_plans();
-  // An LCD line after the eye's first frame: its drive over the line too, whose shortfall joins rho (Sec. 4.4).
-  const bool lcd_line = !line_kernels(out) && line_values(out) && plans.lcd && !out.lcd_held;
+  // An LCD line: its drive over the line too (the eye's first frame included), whose shortfall joins rho (Sec. 4.4).
+  const bool lcd_line = !line_kernels(out) && line_values(out) && plans.lcd;
   if (lost || !(line_kernels(out) || lcd_line)) {
     for (int x = 0; x < g.full.width; ++x) {
       full_pixel(out, eye, y, x, codes_row, scratch.first.data() + 3 * x, residual_row, lost, grey);
@@ -172,13 +172,10 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   Raw* rho = scratch.rho.data();
   if (lcd_line) {
     scratch.shortfall.resize(n);
-    t.counts.lcd_unreachable +=
-        lines::lcd_drive(scratch.shown.data(), n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint16_t>(y),
-                         eye.lcd_previous_linear.ptr<std::int32_t>(y), out.frame.drive_codes.ptr<std::uint16_t>(y),
-                         scratch.shortfall.data());
+    emit_line(out, eye, y, scratch.shown.data(), scratch.shortfall.data());
     for (std::size_t s = 0; s < n; ++s) rho[s] += scratch.shortfall[s];
   } else {
-    lines::drive_codes(scratch.shown.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+    emit_line(out, eye, y, scratch.shown.data(), nullptr);
   }
   for (std::size_t s = 0; s < n; ++s) {
     if (rho[s] == 0) {
@@ -237,7 +234,7 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     t.dropped_sum += m.dropped_sum;
     t.residual_abs_sum += m.residual_abs_sum;
     t.residual_abs_max = std::max(t.residual_abs_max, m.residual_abs_max);
-    emit_line(out, eye, y, scratch.shown.data());
+    emit_line(out, eye, y, scratch.shown.data(), nullptr);
     return;
   }
   Raw* shown = whole_line ? scratch.shown.data() : nullptr;
@@ -245,26 +242,29 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     reduced_pixel(out, eye, y, x, scratch.first.data() + 3 * x,
                   previous_needed ? scratch.second.data() + 3 * x : nullptr, residual_row, gate, grey, shown);
   }
-  if (whole_line) emit_line(out, eye, y, shown);
+  if (whole_line) emit_line(out, eye, y, shown, nullptr);
 }
 
-void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown) const {
-  const std::optional<DrivePlan>& drive = kernels_.line_plans().drive;
-  if (drive) {
-    lines::drive_codes(shown, 3 * static_cast<std::size_t>(eye.full_size.width), *drive,
-                       out.frame.drive_codes.ptr<std::uint16_t>(y));
+void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown, Raw* shortfall) const {
+  const auto n = 3 * static_cast<std::size_t>(eye.full_size.width);
+  const FixedLinePlans& plans = kernels_.line_plans();
+  if (plans.drive) {
+    lines::drive_codes(shown, n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+    if (shortfall != nullptr) std::fill_n(shortfall, n, Raw{0});
     return;
   }
-  const std::optional<LcdPlan>& lcd = kernels_.line_plans().lcd;
-  if (lcd && !out.lcd_held) {
-    out.tally.counts.lcd_unreachable +=
-        lines::lcd_drive(shown, 3 * static_cast<std::size_t>(eye.full_size.width), *lcd, kernels_,
-                         eye.lcd_previous_drive.ptr<std::uint16_t>(y), eye.lcd_previous_linear.ptr<std::int32_t>(y),
-                         out.frame.drive_codes.ptr<std::uint16_t>(y), nullptr);
+  if (plans.lcd) {
+    out.tally.counts.lcd_unreachable += lines::lcd_drive(
+        shown, n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint16_t>(y),
+        eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
+        shortfall);
     return;
   }
   for (int x = 0; x < eye.full_size.width; ++x) {
-    for (int ch = 0; ch < 3; ++ch) emit(out, eye, y, x, ch, shown[3 * x + ch]);
+    for (int ch = 0; ch < 3; ++ch) {
+      const Raw missing = emit(out, eye, y, x, ch, shown[3 * x + ch]);
+      if (shortfall != nullptr) shortfall[3 * x + ch] = missing;
+    }
   }
 }
 

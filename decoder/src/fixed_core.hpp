@@ -247,9 +247,10 @@ class FixedDecoderCore {
   bool line_values(const FrameOutput& out) const {
     return kernels_.line_plans().eotf && !config().report_planes && out.taps == nullptr;
   }
-  // The drive codes of a reduced-frame line's shown values: the OLED drive kernel, the LCD drive kernel after the
-  // eye's first view, else emit per sample in raster order (the LCD's frame stores).
-  void emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown) const;
+  // The drive codes of a line's shown values: the OLED drive kernel, the LCD drive kernel, else emit per sample in
+  // raster order (the LCD's frame stores). shortfall, where not null, receives each sample's LCD shortfall (0 on an
+  // OLED), which a full frame adds to rho (Sec. 4.4).
+  void emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown, Raw* shortfall) const;
   void full_pixel(FrameOutput& out, EyeState& eye, int y, int x, const std::uint16_t* codes_row, const Raw* low,
                   std::int32_t* residual_row, bool lost, bool grey) const;
   // shown: null emits each sample; else the samples' wanted values are stored at shown[3x + ch] for the line's

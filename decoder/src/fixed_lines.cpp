@@ -204,38 +204,74 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
   const hn::ScalableTag<std::uint32_t> du;
   const hn::RebindToSigned<decltype(du)> di;
   const hn::Rebind<std::uint16_t, decltype(du)> d16;
-  const hn::ScalableTag<std::int64_t> d64;
+  const hn::Half<decltype(du)> dh;
+  const hn::Repartition<std::int64_t, decltype(du)> d64;
   const hn::RebindToUnsigned<decltype(d64)> du64;
-  const hn::Rebind<std::uint32_t, decltype(du64)> d32h;
   const std::size_t lanes = hn::Lanes(du);
   thread_local std::vector<std::uint32_t> wide;
-  thread_local std::vector<std::uint32_t> sums;
   wide.resize(row_samples + lanes);
-  sums.resize(n + lanes);
   std::size_t i = 0;
   for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
   for (; i < row_samples; ++i) wide[i] = row[i];
   const auto one = hn::Set(du, 1u);
   const auto rest_mask = hn::Set(du, (std::uint32_t{1} << (shift - 1)) - 1u);
   const auto zero = hn::Zero(du);
-  for (; s + lanes <= n; s += lanes) {
-    auto acc = zero;
-    for (std::size_t t = 0; t < plan.taps; ++t) {
-      const auto code = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.index.data() + t * n + s));
-      acc = hn::Add(acc, hn::Mul(hn::LoadU(du, plan.weight.data() + t * n + s), code));
-    }
-    // Half to even: up where the first dropped bit is set and the rest or the kept LSB is.
+  // Half to even: up where the first dropped bit is set and the rest or the kept LSB is.
+  const auto rounded = [&](const auto acc) {
     const auto kept = hn::ShiftRightSame(acc, shift);
     const auto first = hn::And(hn::ShiftRightSame(acc, shift - 1), one);
     const auto rest = hn::IfThenElseZero(hn::Ne(hn::And(acc, rest_mask), zero), one);
-    hn::StoreU(hn::Add(kept, hn::And(first, hn::Or(rest, hn::And(kept, one)))), du, sums.data() + s);
+    return hn::Add(kept, hn::And(first, hn::Or(rest, hn::And(kept, one))));
+  };
+  const auto widened_low = [&](const auto v) { return hn::BitCast(d64, hn::PromoteTo(du64, hn::LowerHalf(dh, v))); };
+  const auto widened_high = [&](const auto v) { return hn::BitCast(d64, hn::PromoteTo(du64, hn::UpperHalf(dh, v))); };
+  if (plan.decimation != 0) {
+    const std::size_t f = plan.decimation;
+    const std::size_t columns = plan.columns;
+    const std::size_t length = plan.plane_length;
+    thread_local std::vector<std::uint32_t> planes;
+    const std::size_t plane_samples = plan.plane_source.size();
+    planes.resize(plane_samples + lanes);
+    std::size_t p = 0;
+    for (; p + lanes <= plane_samples; p += lanes) {
+      hn::StoreU(hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.plane_source.data() + p)), du, planes.data() + p);
+    }
+    for (; p < plane_samples; ++p) planes[p] = wide[static_cast<std::size_t>(plan.plane_source[p])];
+    const std::uint32_t* red = planes.data();
+    const std::uint32_t* green = red + f * length;
+    const std::uint32_t* blue = green + f * length;
+    const std::size_t half = lanes / 2;
+    std::size_t k = 0;
+    for (; k + lanes <= columns; k += lanes) {
+      auto acc0 = zero;
+      auto acc1 = zero;
+      auto acc2 = zero;
+      for (std::size_t t = 0; t < plan.taps; ++t) {
+        const auto w = hn::LoadU(du, plan.planar_weight.data() + t * columns + k);
+        const std::size_t at = (t % f) * length + k + t / f;
+        acc0 = hn::Add(acc0, hn::Mul(w, hn::LoadU(du, red + at)));
+        acc1 = hn::Add(acc1, hn::Mul(w, hn::LoadU(du, green + at)));
+        acc2 = hn::Add(acc2, hn::Mul(w, hn::LoadU(du, blue + at)));
+      }
+      const auto r0 = rounded(acc0);
+      const auto r1 = rounded(acc1);
+      const auto r2 = rounded(acc2);
+      hn::StoreInterleaved3(widened_low(r0), widened_low(r1), widened_low(r2), d64, out + 3 * k);
+      hn::StoreInterleaved3(widened_high(r0), widened_high(r1), widened_high(r2), d64, out + 3 * (k + half));
+    }
+    s = 3 * k;
+  } else {
+    for (; s + lanes <= n; s += lanes) {
+      auto acc = zero;
+      for (std::size_t t = 0; t < plan.taps; ++t) {
+        const auto code = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.index.data() + t * n + s));
+        acc = hn::Add(acc, hn::Mul(hn::LoadU(du, plan.weight.data() + t * n + s), code));
+      }
+      const auto r = rounded(acc);
+      hn::StoreU(widened_low(r), d64, out + s);
+      hn::StoreU(widened_high(r), d64, out + s + lanes / 2);
+    }
   }
-  const std::size_t wide_lanes = hn::Lanes(d64);
-  std::size_t k = 0;
-  for (; k + wide_lanes <= s; k += wide_lanes) {
-    hn::StoreU(hn::BitCast(d64, hn::PromoteTo(du64, hn::LoadU(d32h, sums.data() + k))), d64, out + k);
-  }
-  for (; k < s; ++k) out[k] = sums[k];
 #endif
   for (; s < n; ++s) out[s] = scalar(s);
 }
@@ -268,9 +304,9 @@ void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, 
 
 // One sample of the LCD drive by the stage function, with emit's frame-store update.
 inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const FixedKernels& kernels,
-                                std::uint16_t& previous_code, std::int32_t& previous_linear, std::int64_t* shortfall,
-                                std::uint64_t& unreachable) {
-  const LcdSample sample = kernels.lcd_drive(wanted, previous_linear, previous_code, false, false);
+                                std::uint16_t& previous_code, std::int32_t& previous_linear, bool held,
+                                std::int64_t* shortfall, std::uint64_t& unreachable) {
+  const LcdSample sample = kernels.lcd_drive(wanted, previous_linear, previous_code, held, false);
   unreachable += sample.unreachable ? 1 : 0;
   if (shortfall != nullptr) *shortfall = sample.shortfall;
   previous_code = sample.code;
@@ -279,7 +315,7 @@ inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const Fix
 }
 
 std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
-                       std::uint16_t* previous_code, std::int32_t* previous_linear, std::uint16_t* codes,
+                       std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                        std::int64_t* shortfall) {
   std::uint64_t unreachable = 0;
   std::size_t s = 0;
@@ -302,10 +338,12 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto top = hn::Set(d, std::int64_t{p.top});
   const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
   const auto exponent_bias = hn::Set(d, std::int64_t{1023});
+  const auto held_row = hn::Set(d, p.width << p.width_log2);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
   for (; s + lanes <= n; s += lanes) {
     const auto x = hn::LoadU(d, wanted + s);
-    const auto x_previous = hn::PromoteTo(d, hn::LoadU(d32, previous_linear + s));
-    const auto j = hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d16, previous_code + s))));
+    // The eye's first frame takes the pixel as held at x_t (FixedKernels::lcd_drive): x_{t-1} = x_t, and v_{t-1} is
+    // found below from the held row.
+    const auto x_previous = held ? x : hn::PromoteTo(d, hn::LoadU(d32, previous_linear + s));
     const auto sum = hn::Add(x, x_previous);
     // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one.
     // (A sum of 2 or more reads 1, not the ROM: its code is clamped as evaluate_raw clamps it.)
@@ -325,18 +363,23 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto target = hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
     const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target), scale));
     // The largest k with M(T_k, v_{t-1}) <= m, branch-free over the merge table's row.
-    const auto row = hn::ShiftLeftSame(j, p.width_log2);
-    auto lo = zero;
-    auto hi = top;
-    for (int i = 0; i < p.steps; ++i) {
-      const auto active = hn::Lt(lo, hi);
-      const auto mid = hn::ShiftRight<1>(hn::Add(hn::Add(lo, hi), unit));
-      const auto merge = hn::GatherIndex(d, p.merge.data(), hn::Add(row, hn::IfThenElse(active, mid, unit)));
-      const auto up = hn::And(active, hn::Not(hn::Lt(target_scaled, merge)));
-      const auto down = hn::AndNot(up, active);
-      lo = hn::IfThenElse(up, mid, lo);
-      hi = hn::IfThenElse(down, hn::Sub(mid, unit), hi);
-    }
+    const auto search = [&](const auto row) {
+      auto lo = zero;
+      auto hi = top;
+      for (int i = 0; i < p.steps; ++i) {
+        const auto active = hn::Lt(lo, hi);
+        const auto mid = hn::ShiftRight<1>(hn::Add(hn::Add(lo, hi), unit));
+        const auto merge = hn::GatherIndex(d, p.merge.data(), hn::Add(row, hn::IfThenElse(active, mid, unit)));
+        const auto up = hn::And(active, hn::Not(hn::Lt(target_scaled, merge)));
+        const auto down = hn::AndNot(up, active);
+        lo = hn::IfThenElse(up, mid, lo);
+        hi = hn::IfThenElse(down, hn::Sub(mid, unit), hi);
+      }
+      return lo;
+    };
+    const auto j = held ? search(held_row)
+                        : hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d16, previous_code + s))));
+    const auto lo = search(hn::ShiftLeftSame(j, p.width_log2));
     const auto end_dark = hn::GatherIndex(d, p.end_dark.data(), j);
     const auto end_bright = hn::GatherIndex(d, p.end_bright.data(), j);
     const auto below = hn::Lt(sum, hn::Add(end_dark, end_dark));
@@ -354,7 +397,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   }
 #endif
   for (; s < n; ++s) {
-    codes[s] = lcd_scalar(wanted[s], p, kernels, previous_code[s], previous_linear[s],
+    codes[s] = lcd_scalar(wanted[s], p, kernels, previous_code[s], previous_linear[s], held,
                           shortfall != nullptr ? shortfall + s : nullptr, unreachable);
   }
   return unreachable;
@@ -551,24 +594,23 @@ std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64
 // it rounds half up, and the interpolation's sum stays in 62 bits.
 std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
   if (lut.is_direct() || lut.is_octave_segmented() || lut.shape().rounding != fx::Quant::Rnd) return std::nullopt;
-  const std::uint64_t step = lut.segment_step();
-  if (!std::has_single_bit(step)) return std::nullopt;
-  const int k = std::countr_zero(step);
+  const std::uint64_t segment = lut.segment_step();
+  if (!std::has_single_bit(segment)) return std::nullopt;
+  const int k = std::countr_zero(segment);
   if (k < 1 || k > 31) return std::nullopt;
   ShiftedRomPlan plan;
   plan.weight_bits = 32 - k;
   const std::vector<std::int64_t>& rom = lut.rom();
   const std::uint64_t top_node = ((std::uint64_t{1} << lut.shape().input_bits) - 1) >> plan.weight_bits;
   if (top_node >= rom.size()) return std::nullopt;
-  plan.node = rom;
-  plan.step.assign(rom.size(), 0);
+  std::vector<std::int64_t> step(rom.size(), 0);
   const std::int64_t limit = std::int64_t{1} << (61 - plan.weight_bits);
   for (std::size_t i = 0; i < rom.size(); ++i) {
     if (rom[i] <= -limit || rom[i] >= limit) return std::nullopt;
-    if (i + 1 < rom.size()) plan.step[i] = rom[i + 1] - rom[i];
-    if (plan.step[i] < INT32_MIN || plan.step[i] > INT32_MAX) return std::nullopt;
+    if (i + 1 < rom.size()) step[i] = rom[i + 1] - rom[i];
+    if (step[i] < INT32_MIN || step[i] > INT32_MAX) return std::nullopt;
   }
-  std::optional<std::vector<std::int64_t>> packed = packed_rom(plan.node, plan.step);
+  std::optional<std::vector<std::int64_t>> packed = packed_rom(rom, step);
   if (!packed) return std::nullopt;
   plan.packed = std::move(*packed);
   return plan;
@@ -766,6 +808,43 @@ GaussianColumnsPlan gaussian_columns_plan(const Geometry& g) {
       }
     }
   }
+  // The polyphase form, where column k's support starts at f k + c (the taps are clamped, so the planes are too).
+  const auto full_width = static_cast<std::size_t>(g.full.width);
+  const std::size_t columns = g.gauss_cols.size();
+  if (columns == 0 || full_width % columns != 0) return plan;
+  const std::size_t f = full_width / columns;
+  // Column k's unclamped start, from a column whose support is inside the row (the middle one, for any sane sigma).
+  const std::size_t middle = columns / 2;
+  const std::int64_t start = static_cast<std::int64_t>(g.gauss_cols[middle].index.front()) -
+                             static_cast<std::int64_t>(f * middle);
+  const auto clamped = [&](std::int64_t column) {
+    return static_cast<int>(std::clamp<std::int64_t>(column, 0, static_cast<std::int64_t>(full_width) - 1));
+  };
+  for (std::size_t k = 0; k < columns; ++k) {
+    const PolyphaseTaps& taps = g.gauss_cols[k];
+    for (std::size_t t = 0; t < taps.index.size(); ++t) {
+      if (taps.index[t] != clamped(start + static_cast<std::int64_t>(f * k + t))) return plan;
+    }
+  }
+  plan.decimation = f;
+  plan.columns = columns;
+  plan.plane_length = columns + (plan.taps - 1) / f;
+  plan.plane_source.resize(3 * f * plan.plane_length);
+  for (std::size_t ch = 0; ch < 3; ++ch) {
+    for (std::size_t p = 0; p < f; ++p) {
+      for (std::size_t m = 0; m < plan.plane_length; ++m) {
+        plan.plane_source[(ch * f + p) * plan.plane_length + m] =
+            3 * clamped(start + static_cast<std::int64_t>(f * m + p)) + static_cast<int>(ch);
+      }
+    }
+  }
+  plan.planar_weight.assign(plan.taps * columns, 0);
+  for (std::size_t k = 0; k < columns; ++k) {
+    const PolyphaseTaps& taps = g.gauss_cols[k];
+    for (std::size_t t = 0; t < taps.weight.size(); ++t) {
+      plan.planar_weight[t * columns + k] = static_cast<std::uint32_t>(taps.weight[t]);
+    }
+  }
   return plan;
 }
 
@@ -807,9 +886,10 @@ void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight,
   HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, out);
 }
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
-                        std::uint16_t* previous_code, std::int32_t* previous_linear, std::uint16_t* codes,
+                        std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                         std::int64_t* shortfall) {
-  return HWY_DYNAMIC_DISPATCH(LcdDrive)(wanted, n, plan, kernels, previous_code, previous_linear, codes, shortfall);
+  return HWY_DYNAMIC_DISPATCH(LcdDrive)(wanted, n, plan, kernels, previous_code, previous_linear, held, codes,
+                                        shortfall);
 }
 void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {

@@ -55,11 +55,23 @@ struct DrivePlan {
 // D's horizontal half over a line (FixedKernels::gaussian_horizontal_line, encoded space), one entry per reduced
 // output sample s = 3k + ch of tap slot t at [t n + s] (n = 3 reduced.width): the row sample the tap reads and its
 // weight, uQ0.T; slots past a column's own taps weigh 0. Each exact sum stays below max_code 2^T < 2^32.
+//
+// Where the taps are regular (column k's support starts at f k + c for an integer decimation f = full / reduced width,
+// as at r = 1/2 or 1/4), the kernel reads them as a polyphase filter instead of one gather per tap: the row is laid
+// out once per line as 3 f planes, plane (ch, p) holding channel ch at the (clamped) columns c + f m + p, so that tap
+// t of columns k.. is the contiguous run at m = k + t div f of plane (ch, t mod f). The same products are summed
+// exactly, so the bits are the gather's.
 struct GaussianColumnsPlan {
   std::vector<std::int32_t> index;
   std::vector<std::uint32_t> weight;
   std::size_t taps = 0;     // slots per sample
   std::size_t samples = 0;  // n
+  // The polyphase form; decimation 0 where the taps are not regular.
+  std::size_t decimation = 0;          // f
+  std::size_t columns = 0;             // reduced width K
+  std::size_t plane_length = 0;        // M = K + (taps - 1) div f
+  std::vector<std::int32_t> plane_source;     // [(ch f + p) M + m]: the row sample of plane (ch, p) at m
+  std::vector<std::uint32_t> planar_weight;   // [t K + k]: tap slot t's weight of column k (every channel's)
 };
 
 // D's rounding shifts where its sums fit 32-bit lanes (horizontal) and 32-bit operands (vertical).
@@ -72,9 +84,7 @@ struct GaussianPlan {
 // code mod 2^j for j = 32 - k, and the interpolation ((y_i << j) + (y_{i+1} - y_i) weight + 2^(j-1)) >> j is
 // InterpolatedLut::interpolate's add-half-and-shift divided through by 2^k. The last step is 0, as for EotfPlan.
 struct ShiftedRomPlan {
-  std::vector<std::int64_t> node;
-  std::vector<std::int64_t> step;
-  std::vector<std::int64_t> packed;  // as EotfPlan::packed
+  std::vector<std::int64_t> packed;  // as EotfPlan::packed (node << 32 | step)
   int weight_bits = 0;  // j
 };
 
@@ -118,7 +128,7 @@ struct LcdPlan {
   int linear_frac_bits = 0;
   std::int64_t one = 0;
   std::uint32_t scale = 0;  // (2 Mx)^2: the target's scaling to the merge table's integers
-  std::vector<std::int64_t> merge;  // (2^o) rows of 2^o words: row v_{t-1}, column k
+  std::vector<std::int64_t> merge;  // 2^o + 1 rows of 2^o words: row v_{t-1} (row 2^o: M(v, v)), column k
   std::int64_t width = 0;           // 2^o
   int width_log2 = 0;
   int top = 0;                      // 2^o - 1
@@ -165,12 +175,12 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
 // D's vertical half: out[i] = round(sum_j weight[j] rows[j][i], T + L), half up, for i < n (rows[j][i] < 2^32).
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
                    int shift, std::uint16_t* out);
-// The LCD drive of n samples of one line after the eye's first frame: codes[s] and, where shortfall is not null,
-// shortfall[s] as FixedKernels::lcd_drive(wanted[s], previous_linear[s], previous_code[s], false) gives them, and
-// the frame stores previous_code / previous_linear replaced as FixedDecoderCore::emit replaces them. Returns the
-// number of unreachable samples.
+// The LCD drive of n samples of one line: codes[s] and, where shortfall is not null, shortfall[s] as
+// FixedKernels::lcd_drive(wanted[s], previous_linear[s], previous_code[s], held) gives them, and the frame stores
+// previous_code / previous_linear replaced as FixedDecoderCore::emit replaces them (held: the eye's first frame,
+// whose stores are written and not read). Returns the number of unreachable samples.
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
-                        std::uint16_t* previous_code, std::int32_t* previous_linear, std::uint16_t* codes,
+                        std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                         std::int64_t* shortfall);
 // Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
 // whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions

@@ -74,15 +74,18 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
     int output_bits;
     bool stereo;
     bool skip;
+    int width;
   };
   // 67 pixels: 201 samples per line, a tail after every vector width; r = 0.4 gives non-dyadic U weights; on the LCD
-  // the reduced frames take the line kernels up to the drive, which stays per sample.
+  // the reduced frames take the line kernels up to the drive, which stays per sample. 66 and 68 pixels at r = 1/2
+  // and 1/4 divide evenly, so D's horizontal half takes its polyphase planes (33 and 17 columns: tails again).
   const std::vector<Case> cases = {
-      {"panorama", 0.5, "vive", 8, false, true},  {"discs", 0.4, "rift", 10, false, true},
-      {"checker", 0.5, "vive", 8, true, false},   {"text", 0.75, "vive", 8, false, true},
-      {"zoneplate", 0.25, "rift", 8, false, true}, {"flash", 0.5, "vive", 10, false, true},
-      {"jitter", 0.5, "vive", 8, false, false},  {"panorama", 0.5, "lcd", 8, false, true},
-      {"discs", 0.4, "lcd", 8, true, false},
+      {"panorama", 0.5, "vive", 8, false, true, 67},  {"discs", 0.4, "rift", 10, false, true, 67},
+      {"checker", 0.5, "vive", 8, true, false, 67},   {"text", 0.75, "vive", 8, false, true, 67},
+      {"zoneplate", 0.25, "rift", 8, false, true, 67}, {"flash", 0.5, "vive", 10, false, true, 67},
+      {"jitter", 0.5, "vive", 8, false, false, 67},  {"panorama", 0.5, "lcd", 8, false, true, 67},
+      {"discs", 0.4, "lcd", 8, true, false, 67},     {"panorama", 0.5, "vive", 8, true, true, 66},
+      {"zoneplate", 0.25, "lcd", 10, false, false, 68},
   };
   const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());
@@ -91,7 +94,7 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
     ASSERT_STREQ(fixed_detail::lines::target_name(), hwy::TargetName(target)) << "the dispatch follows the mock";
     for (const Case& c : cases) {
       const EncoderConfig link = link_config(c.r, 0, c.stereo);
-      const auto frames = encode_sequence(scene_images(c.scene, 67, 46, 6), link);
+      const auto frames = encode_sequence(scene_images(c.scene, c.width, 46, 6), link);
       FixedDecoderConfig config = fixed_config(link, c.panel, c.output_bits);
       config.skip_unneeded = c.skip;
       for (const bool planes : {true, false}) {
@@ -240,14 +243,74 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
   }
 }
 
+// D's horizontal half through the polyphase planes (regular taps: column k's support starts at f k + c, clamped at
+// both ends) against the sums of the taps themselves, at decimations 2 and 4 with columns of fewer taps than the
+// slots and exact ties; and the same taps with one index moved off the pattern, which must take the gather.
+TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
+  std::mt19937_64 random(23);
+  constexpr int kColumns = 35;  // a tail after every vector width
+  constexpr int kHorizontalShift = 8;
+  for (const int f : {2, 4}) {
+    for (const bool regular : {true, false}) {
+      fixed_detail::Geometry g;
+      g.full = cv::Size(f * kColumns, 1);
+      g.reduced = cv::Size(kColumns, 1);
+      const int taps_per_column = 4 * f + 1;
+      for (int k = 0; k < kColumns; ++k) {
+        fixed_detail::PolyphaseTaps taps;
+        const int count = k % 5 == 0 ? taps_per_column - 1 : taps_per_column;
+        for (int t = 0; t < count; ++t) {
+          taps.index.push_back(std::clamp(f * k - 2 * f + t, 0, g.full.width - 1));
+          const auto w = static_cast<std::int64_t>(random() % ((1u << 24) / taps_per_column));
+          taps.weight.push_back(k % 3 == 0 ? w & ~std::int64_t{0x7f} : w);  // multiples of 2^7: exact ties
+        }
+        g.gauss_cols.push_back(taps);
+      }
+      if (!regular) g.gauss_cols[kColumns / 3].index[1] += 1;
+      const fixed_detail::GaussianColumnsPlan plan = fixed_detail::gaussian_columns_plan(g);
+      ASSERT_EQ(plan.decimation, regular ? static_cast<std::size_t>(f) : 0u) << "f=" << f;
+      const std::size_t row_samples = 3 * static_cast<std::size_t>(g.full.width);
+      std::vector<std::uint16_t> row(row_samples);
+      for (std::uint16_t& code : row) code = static_cast<std::uint16_t>(random() % 256);
+      std::vector<std::int64_t> expected(plan.samples);
+      int ties = 0;
+      for (int k = 0; k < kColumns; ++k) {
+        const fixed_detail::PolyphaseTaps& taps = g.gauss_cols[static_cast<std::size_t>(k)];
+        for (int ch = 0; ch < 3; ++ch) {
+          std::int64_t acc = 0;
+          for (std::size_t t = 0; t < taps.weight.size(); ++t) acc += taps.weight[t] * row[3 * taps.index[t] + ch];
+          ties += (acc & 0xff) == 0x80 ? 1 : 0;
+          expected[3 * static_cast<std::size_t>(k) + ch] = fx::rounded_shift(acc, kHorizontalShift, fx::Quant::RndConv);
+        }
+      }
+      EXPECT_GT(ties, 2) << "the half-to-even rounding is exercised";
+      for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        const TargetMock mock(target);
+        std::vector<std::int64_t> columns(plan.samples, -1);
+        fixed_detail::lines::gaussian_columns(row.data(), row_samples, plan, kHorizontalShift, columns.data());
+        for (std::size_t s = 0; s < plan.samples; ++s) {
+          ASSERT_EQ(columns[s], expected[s])
+              << hwy::TargetName(target) << " f=" << f << (regular ? " polyphase" : " gather") << " sample " << s;
+        }
+      }
+    }
+  }
+}
+
 // The LCD drive kernel against FixedKernels::lcd_drive and emit's frame-store update, sample by sample: random wanted
 // and previous values (sums from 0 to past 2, so the target ROM's every octave, its bottom region and the clamp to
-// 1 are read), random v_{t-1}, both history modes (Contributed stores negative values after a dark shortfall), on
-// every instruction set.
+// 1 are read), random v_{t-1}, both history modes (Contributed stores negative values after a dark shortfall), the
+// eye's first frame (held: the stores are written, not read), on every instruction set.
 TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
+  struct Case {
+    LcdHistory history;
+    int linear_frac_bits;
+    bool held;
+  };
   // F = 20 besides the default: there one LSB of the target m moves a code often enough to be seen.
-  for (const auto& [history, linear_frac_bits] : {std::pair{LcdHistory::Wanted, 28}, std::pair{LcdHistory::Contributed, 28},
-                                                  std::pair{LcdHistory::Wanted, 20}}) {
+  for (const auto& [history, linear_frac_bits, held] :
+       {Case{LcdHistory::Wanted, 28, false}, Case{LcdHistory::Contributed, 28, false}, Case{LcdHistory::Wanted, 20, false},
+        Case{LcdHistory::Wanted, 28, true}, Case{LcdHistory::Contributed, 20, true}}) {
     FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
     config.decoder.lcd_history = history;
     config.linear_frac_bits = linear_frac_bits;
@@ -276,7 +339,8 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
     std::vector<std::int64_t> expected_shortfall(kSamples);
     std::uint64_t expected_unreachable = 0;
     for (std::size_t s = 0; s < kSamples; ++s) {
-      const fixed_detail::LcdSample sample = kernels.lcd_drive(wanted[s], previous_linear[s], previous_code[s], false, false);
+      const fixed_detail::LcdSample sample =
+          kernels.lcd_drive(wanted[s], previous_linear[s], previous_code[s], held, false);
       expected_codes[s] = sample.code;
       expected_shortfall[s] = sample.shortfall;
       expected_unreachable += sample.unreachable ? 1 : 0;
@@ -288,12 +352,13 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
       const TargetMock mock(target);
       const std::string where = std::string(hwy::TargetName(target)) +
                                 (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
-                                std::to_string(linear_frac_bits);
+                                std::to_string(linear_frac_bits) + (held ? " held" : "");
       std::vector<std::uint16_t> store_code(previous_code), codes(kSamples);
       std::vector<std::int32_t> store_linear(previous_linear);
       std::vector<std::int64_t> shortfall(kSamples);
       const std::uint64_t unreachable = fixed_detail::lines::lcd_drive(
-          wanted.data(), kSamples, *plan, kernels, store_code.data(), store_linear.data(), codes.data(), shortfall.data());
+          wanted.data(), kSamples, *plan, kernels, store_code.data(), store_linear.data(), held, codes.data(),
+          shortfall.data());
       EXPECT_EQ(unreachable, expected_unreachable) << where;
       for (std::size_t s = 0; s < kSamples; ++s) {
         ASSERT_EQ(codes[s], expected_codes[s]) << where << " sample " << s << " wanted " << wanted[s];
