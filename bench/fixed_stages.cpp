@@ -248,6 +248,42 @@ void BM_LineUpsampleEotf(benchmark::State& state) {
 }
 BENCHMARK(BM_LineUpsampleEotf);
 
+// U's two halves apart: the column blend of one reduced row (run once per reduced row and cached for the two output
+// lines that read it) and the row blend with the EOTF (once per output line and pass).
+void BM_LineBlendColumns(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const std::vector<std::uint16_t> row = random_codes(3 * g.reduced.width, kernels.max_code(), 2);
+  const auto n = static_cast<std::size_t>(3 * kWidth);
+  std::vector<std::uint32_t> out(n);
+  for (auto _ : state) {
+    trm::fixed_detail::lines::blend_columns(row.data(), g.column_blend, n, out.data());
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineBlendColumns);
+
+void BM_LineBlendRowsEotf(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const auto n = static_cast<std::size_t>(3 * kWidth);
+  std::vector<std::uint32_t> top(n), bottom(n);
+  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 2).data(),
+                                          g.column_blend, n, top.data());
+  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 3).data(),
+                                          g.column_blend, n, bottom.data());
+  std::vector<Raw> out(n);
+  for (auto _ : state) {
+    trm::fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n,
+                                              static_cast<std::uint32_t>(g.bilinear_rows[1].upper),
+                                              *kernels.line_plans().eotf, out.data());
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineBlendRowsEotf);
+
 void BM_LineCompensate(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const std::vector<std::uint16_t> codes = random_codes(3 * kWidth, kernels.max_code(), 4);

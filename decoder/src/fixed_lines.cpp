@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <iterator>
 
 HWY_BEFORE_NAMESPACE();
 namespace trm::fixed_detail::lines {
@@ -30,6 +31,16 @@ inline std::int64_t eotf_scalar(std::uint64_t blended, const EotfPlan& p) {
 
 inline std::uint16_t drive_scalar(std::int64_t x, std::size_t s, const DrivePlan& p) {
   const auto u = static_cast<std::uint64_t>(x);
+  if (x < 0 || x >= p.value_limit) {  // threshold_search: the largest k with x >= T_k
+    const std::int64_t* t = p.thresholds.data() + p.threshold_offset[s % 3];
+    int lo = 0;
+    int hi = p.threshold_count[s % 3] - 1;
+    while (lo < hi) {
+      const int mid = (lo + hi + 1) / 2;
+      if (x >= t[mid]) lo = mid; else hi = mid - 1;
+    }
+    return static_cast<std::uint16_t>(lo);
+  }
   const int lead = static_cast<int>(std::bit_width(u)) - 1;
   const int m = p.mantissa_bits;
   const std::int64_t bucket =
@@ -112,8 +123,67 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   }
 }
 
+// DriveCodes in 32-bit lanes (DrivePlan::base32 ..): the bucket from a float's exponent and fraction, exact because
+// a value of 2^24 or more is converted shifted right by 5 (its top m + 1 bits kept, m = 7), and one below exactly.
+std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[maybe_unused]] std::size_t n,
+                             [[maybe_unused]] const DrivePlan& p, [[maybe_unused]] std::uint16_t* out) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int32_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Rebind<float, decltype(d)> df;
+  const hn::Half<decltype(du)> duh;
+  const hn::Repartition<std::int64_t, decltype(d)> d64;
+  const hn::RebindToUnsigned<decltype(d64)> du64;
+  const hn::Rebind<std::uint16_t, decltype(d)> d16;
+  const std::size_t lanes = hn::Lanes(d);
+  const std::size_t half = lanes / 2;
+  const int m = p.mantissa_bits;
+  const auto zero64 = hn::Zero(d64);
+  const auto limit64 = hn::Set(d64, p.value_limit);
+  const auto small = hn::Set(d, std::int32_t{1} << m);
+  const auto exact_float = hn::Set(d, std::int32_t{1} << 24);
+  const auto mantissa_mask = hn::Set(du, (std::uint32_t{1} << m) - 1);
+  const auto exponent_bias = hn::Set(d, std::int32_t{127} + m - 1);
+  const auto five = hn::Set(d, std::int32_t{5});
+  const auto one = hn::Set(d, std::int32_t{1});
+  const std::size_t phase_step = lanes % 3;
+  std::size_t phase = 0;
+  for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
+    const auto low = hn::LoadU(d64, linear + s);
+    const auto high = hn::LoadU(d64, linear + s + half);
+    const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero64), hn::Not(hn::Lt(v, limit64))); };
+    if (!hn::AllFalse(d64, hn::Or(outside(low), outside(high)))) {  // outside the index: generic search
+      for (std::size_t i = 0; i < lanes; ++i) out[s + i] = drive_scalar(linear[s + i], s + i, p);
+      continue;
+    }
+    const auto x = hn::BitCast(d, hn::Combine(du, hn::TruncateTo(duh, hn::BitCast(du64, high)),
+                                              hn::TruncateTo(duh, hn::BitCast(du64, low))));
+    const auto large = hn::Not(hn::Lt(x, exact_float));
+    const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<5>(x), x)));
+    const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, five));
+    const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 23 - m), mantissa_mask));
+    const auto octave = hn::ShiftLeftSame(hn::Sub(exponent, exponent_bias), m);
+    const auto bucket = hn::IfThenElse(hn::Lt(x, small), x, hn::Add(octave, top_bits));
+    auto k = hn::GatherIndex(d, p.base32.data(), hn::Add(bucket, hn::LoadU(d, p.bucket_offset32.data() + phase)));
+    for (int i = 0; i < p.steps; ++i) {
+      const auto threshold = hn::GatherIndex(d, p.thresholds32.data(), hn::Add(k, one));
+      k = hn::Add(k, hn::IfThenZeroElse(hn::Lt(x, threshold), one));
+    }
+    const auto code = hn::Sub(k, hn::LoadU(d, p.threshold_offset32.data() + phase));
+    hn::StoreU(hn::DemoteTo(d16, code), d16, out + s);
+  }
+#endif
+  return s;
+}
+
 void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, std::uint16_t* out) {
   std::size_t s = 0;
+  if (!p.base32.empty()) {
+    s = DriveCodesNarrow(linear, n, p, out);
+    for (; s < n; ++s) out[s] = drive_scalar(linear[s], s, p);
+    return;
+  }
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
   const hn::RebindToUnsigned<decltype(d)> du;
@@ -745,32 +815,48 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     }
   }
   if (!kernels.lcd()) {
-    DrivePlan d;
-    d.mantissa_bits = ThresholdIndex::kMantissaBits;
-    bool usable = true;
-    std::array<std::int64_t, 3> bucket_start{};
-    std::array<std::int64_t, 3> threshold_start{};
-    for (int ch = 0; ch < 3; ++ch) {
-      const ThresholdIndex& index = kernels.drive_index(ch);
-      usable = usable && index.steps() > 0 && index.value_bits() == kernels.drive_index(0).value_bits();
-      if (!usable) break;
-      bucket_start[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(d.base.size());
-      threshold_start[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(d.thresholds.size());
-      for (std::uint16_t code : index.base()) d.base.push_back(threshold_start[static_cast<std::size_t>(ch)] + code);
-      d.thresholds.insert(d.thresholds.end(), index.padded().begin(), index.padded().end());
-      // More steps than a channel needs stop at its code (its thresholds increase, then the padding no x reaches).
-      d.steps = std::max(d.steps, index.steps());
-    }
-    if (usable) {
-      d.value_limit = std::int64_t{1} << kernels.drive_index(0).value_bits();
-      for (int i = 0; i < 3 + DrivePlan::kMaxLanes; ++i) {
-        d.bucket_offset.push_back(bucket_start[static_cast<std::size_t>(i % 3)]);
-        d.threshold_offset.push_back(threshold_start[static_cast<std::size_t>(i % 3)]);
-      }
-      plans.drive = std::move(d);
-    }
+    plans.drive = drive_plan({&kernels.drive_index(0), &kernels.drive_index(1), &kernels.drive_index(2)});
   }
   return plans;
+}
+
+std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& channels) {
+  DrivePlan d;
+  d.mantissa_bits = ThresholdIndex::kMantissaBits;
+  bool usable = true;
+  std::array<std::int64_t, 3> bucket_start{};
+  std::array<std::int64_t, 3> threshold_start{};
+  for (int ch = 0; ch < 3; ++ch) {
+    const ThresholdIndex& index = *channels[static_cast<std::size_t>(ch)];
+    usable = usable && index.steps() > 0 && index.value_bits() == channels[0]->value_bits();
+    if (!usable) break;
+    bucket_start[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(d.base.size());
+    threshold_start[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(d.thresholds.size());
+    for (std::uint16_t code : index.base()) d.base.push_back(threshold_start[static_cast<std::size_t>(ch)] + code);
+    d.thresholds.insert(d.thresholds.end(), index.padded().begin(), index.padded().end());
+    d.threshold_count[static_cast<std::size_t>(ch)] =
+        static_cast<int>(index.padded().size()) - (ThresholdIndex::kMaxSteps + 1);
+    // More steps than a channel needs stop at its code (its thresholds increase, then the padding no x reaches).
+    d.steps = std::max(d.steps, index.steps());
+  }
+  if (usable) {
+    d.value_limit = std::int64_t{1} << channels[0]->value_bits();
+    for (int i = 0; i < 3 + DrivePlan::kMaxLanes; ++i) {
+      d.bucket_offset.push_back(bucket_start[static_cast<std::size_t>(i % 3)]);
+      d.threshold_offset.push_back(threshold_start[static_cast<std::size_t>(i % 3)]);
+    }
+    if (channels[0]->value_bits() <= 30 && d.mantissa_bits <= 18 && d.thresholds.size() < (std::size_t{1} << 30)) {
+      const auto narrow = [](std::int64_t v) {
+        return static_cast<std::int32_t>(std::clamp<std::int64_t>(v, INT32_MIN, INT32_MAX));
+      };
+      std::ranges::transform(d.base, std::back_inserter(d.base32), narrow);
+      std::ranges::transform(d.thresholds, std::back_inserter(d.thresholds32), narrow);
+      std::ranges::transform(d.bucket_offset, std::back_inserter(d.bucket_offset32), narrow);
+      std::ranges::transform(d.threshold_offset, std::back_inserter(d.threshold_offset32), narrow);
+    }
+    return d;
+  }
+  return std::nullopt;
 }
 
 ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {

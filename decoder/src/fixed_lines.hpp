@@ -15,6 +15,7 @@ namespace trm::fixed_detail {
 
 class FixedKernels;
 struct Geometry;
+class ThresholdIndex;
 
 // U's column blend of one reduced row, one entry per output sample s = 3x + ch of the full-width line: the row
 // samples of the column's two taps and the weight of the right one, uQ0.W. The exact sum (2^W - w) a + w b is kept
@@ -47,9 +48,17 @@ struct DrivePlan {
   static constexpr int kMaxLanes = 64;
   std::vector<std::int64_t> bucket_offset;
   std::vector<std::int64_t> threshold_offset;
+  std::array<int, 3> threshold_count{};  // each channel's thresholds before the padding (the generic search's)
   int steps = 0;
   int mantissa_bits = 0;
-  std::int64_t value_limit = 0;  // 2^value_bits: larger values take the generic search
+  std::int64_t value_limit = 0;  // 2^value_bits: larger values (and negative ones) take the generic search
+  // The same tables in 32 bits, where every value below value_limit and every table index fits (value_bits <= 30,
+  // F = 28 by default): twice the lanes per vector. Thresholds above INT32_MAX, which no such value reaches, are
+  // clamped to it. Empty otherwise.
+  std::vector<std::int32_t> base32;
+  std::vector<std::int32_t> thresholds32;
+  std::vector<std::int32_t> bucket_offset32;
+  std::vector<std::int32_t> threshold_offset32;
 };
 
 // D's horizontal half over a line (FixedKernels::gaussian_horizontal_line, encoded space), one entry per reduced
@@ -153,6 +162,9 @@ struct FixedLinePlans {
 
 // The column blend plan of a view size (for FixedLinePlans::eotf).
 ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit);
+// The OLED drive code search of three channels' threshold indices (for FixedLinePlans::drive), or nothing where an
+// index is not usable or their value ranges differ.
+std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& channels);
 // D's horizontal taps of a view size as tap slots (for FixedLinePlans::gaussian).
 GaussianColumnsPlan gaussian_columns_plan(const Geometry& g);
 

@@ -5,6 +5,7 @@
 #include "fixed_decoder_test_support.hpp"
 #include "fixed_kernels.hpp"
 #include "fixed_lines.hpp"
+#include "fixed_tables.hpp"
 #include "trm/fx_quantise.hpp"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -293,6 +295,78 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
               << hwy::TargetName(target) << " f=" << f << (regular ? " polyphase" : " gather") << " sample " << s;
         }
       }
+    }
+  }
+}
+
+// The OLED drive code kernel (both lane widths: the 32-bit tables of DrivePlan and the 64-bit ones) against
+// FixedKernels::drive_code, value by value: every channel's thresholds and their neighbours, both sides of 2^24 (where
+// the 32-bit lanes' float conversion changes form), every octave, random values, and values outside [0, 1] (the
+// generic search), on every instruction set.
+TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
+  const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive", 10);
+  const fixed_detail::FixedKernels kernels(config);
+  ASSERT_TRUE(kernels.line_plans().drive.has_value());
+  const fixed_detail::DrivePlan& narrow = *kernels.line_plans().drive;
+  fixed_detail::DrivePlan wide_tables = narrow;
+  ASSERT_FALSE(narrow.base32.empty()) << "the default formats take the 32-bit lanes";
+  wide_tables.base32.clear();
+  const fixed_detail::DrivePlan& wide = wide_tables;
+  const std::int64_t one = kernels.one();
+  std::vector<std::int64_t> values;
+  // Sample s is read as channel s mod 3: each channel's thresholds go to its own samples.
+  for (int ch = 0; ch < 3; ++ch) {
+    for (const std::int64_t t : kernels.drive_index(ch).padded()) {
+      for (const std::int64_t v : {t - 1, t, t + 1}) {
+        if (v < 0 || v > one) continue;
+        while (values.size() % 3 != static_cast<std::size_t>(ch)) values.push_back(one / 2);
+        values.push_back(v);
+      }
+    }
+  }
+  for (int bit = 0; bit <= config.linear_frac_bits; ++bit) {
+    for (const std::int64_t v : {(std::int64_t{1} << bit) - 1, std::int64_t{1} << bit, (std::int64_t{1} << bit) + 31}) {
+      if (v >= 0 && v <= one) values.push_back(v);
+    }
+  }
+  std::mt19937_64 random(29);
+  std::uniform_int_distribution<std::int64_t> linear(0, one);
+  for (int i = 0; i < 20000; ++i) values.push_back(linear(random));
+  values.push_back(-1);
+  values.push_back(one + 1);
+  values.push_back(std::int64_t{1} << 40);
+  std::vector<std::uint16_t> expected(values.size());
+  for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_code(values[s], static_cast<int>(s % 3));
+  // A ROM with thresholds at 2^k - 1 and 2^k for every k below 2^30: the last value of each octave has a code of its
+  // own, which a float conversion that rounded 2^k - 1 up to 2^k would miss.
+  std::vector<std::int64_t> octave_ends{0};
+  for (int k = 1; k < 30; ++k) {
+    if ((std::int64_t{1} << k) - 1 > octave_ends.back()) octave_ends.push_back((std::int64_t{1} << k) - 1);
+    octave_ends.push_back(std::int64_t{1} << k);
+  }
+  const fixed_detail::ThresholdIndex ends(octave_ends, 30);
+  const std::optional<fixed_detail::DrivePlan> ends_plan = fixed_detail::drive_plan({&ends, &ends, &ends});
+  ASSERT_TRUE(ends_plan.has_value() && !ends_plan->base32.empty());
+  std::vector<std::int64_t> end_values;
+  for (const std::int64_t t : octave_ends) {
+    for (const std::int64_t v : {t - 2, t - 1, t, t + 1}) end_values.push_back(v);
+  }
+  std::vector<std::uint16_t> end_expected(end_values.size());
+  for (std::size_t s = 0; s < end_values.size(); ++s) end_expected[s] = ends.search(end_values[s]);
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    const TargetMock mock(target);
+    for (const fixed_detail::DrivePlan* plan : {&narrow, &wide}) {
+      std::vector<std::uint16_t> codes(values.size());
+      fixed_detail::lines::drive_codes(values.data(), values.size(), *plan, codes.data());
+      for (std::size_t s = 0; s < values.size(); ++s) {
+        ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << (plan == &wide ? " 64-bit" : " 32-bit")
+                                         << " sample " << s << " value " << values[s];
+      }
+    }
+    std::vector<std::uint16_t> codes(end_values.size());
+    fixed_detail::lines::drive_codes(end_values.data(), end_values.size(), *ends_plan, codes.data());
+    for (std::size_t s = 0; s < end_values.size(); ++s) {
+      ASSERT_EQ(codes[s], end_expected[s]) << hwy::TargetName(target) << " octave ends, value " << end_values[s];
     }
   }
 }
