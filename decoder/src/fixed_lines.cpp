@@ -75,6 +75,15 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
   for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
   for (; i < row_samples; ++i) wide[i] = row[i];
   std::size_t s = 0;
+  if (const ColumnBlendPlan::Windows* windows = plan.windows_for(lanes)) {
+    for (std::size_t block = 0; s + lanes <= n; s += lanes, ++block) {
+      const auto window = hn::LoadU(du, wide.data() + windows->start[block]);
+      const auto a = hn::TableLookupLanes(window, hn::IndicesFromVec(du, hn::LoadU(di, windows->left.data() + s)));
+      const auto b = hn::TableLookupLanes(window, hn::IndicesFromVec(du, hn::LoadU(di, windows->right.data() + s)));
+      const auto w = hn::LoadU(du, plan.upper.data() + s);
+      hn::StoreU(hn::Add(hn::Mul(hn::Sub(unit, w), a), hn::Mul(w, b)), du, out + s);
+    }
+  }
   for (; s + lanes <= n; s += lanes) {
     const auto a = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.left.data() + s));
     const auto b = hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.right.data() + s));
@@ -874,6 +883,24 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
       plan.right[s] = 3 * col.i1 + ch;
       plan.upper[s] = static_cast<std::uint32_t>(col.upper);
     }
+  }
+  for (std::size_t i = 0; i < plan.windows.size(); ++i) {
+    const std::size_t width = std::size_t{4} << i;
+    ColumnBlendPlan::Windows w;
+    bool fits = true;
+    for (std::size_t start = 0; fits && start + width <= samples; start += width) {
+      const auto first = std::min(*std::min_element(plan.left.begin() + static_cast<std::ptrdiff_t>(start),
+                                                    plan.left.begin() + static_cast<std::ptrdiff_t>(start + width)),
+                                  *std::min_element(plan.right.begin() + static_cast<std::ptrdiff_t>(start),
+                                                    plan.right.begin() + static_cast<std::ptrdiff_t>(start + width)));
+      w.start.push_back(first);
+      for (std::size_t s = start; s < start + width; ++s) {
+        w.left.push_back(plan.left[s] - first);
+        w.right.push_back(plan.right[s] - first);
+        fits = fits && w.left.back() < static_cast<std::int32_t>(width) && w.right.back() < static_cast<std::int32_t>(width);
+      }
+    }
+    if (fits) plan.windows[i] = std::move(w);
   }
   return plan;
 }

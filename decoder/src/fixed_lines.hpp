@@ -25,6 +25,22 @@ struct ColumnBlendPlan {
   std::vector<std::int32_t> right;
   std::vector<std::uint32_t> upper;
   std::uint32_t unit = 0;  // 2^W
+  // The taps of a vector of L output samples lie within L consecutive row samples wherever r is not far below 1/2 (a
+  // vector reads about L r of them): the kernel then loads that window once and permutes it (a lane table lookup)
+  // instead of gathering each tap. Per vector width L (4, 8, 16 lanes of 32 bits): the window's start per block of L
+  // samples and each sample's taps relative to it; empty for a width whose windows do not fit.
+  struct Windows {
+    std::vector<std::int32_t> start;  // per block
+    std::vector<std::int32_t> left;   // per sample, in [0, L)
+    std::vector<std::int32_t> right;
+  };
+  std::array<Windows, 3> windows;  // L = 4 << i
+  const Windows* windows_for(std::size_t lanes) const {
+    for (std::size_t i = 0; i < windows.size(); ++i) {
+      if ((std::size_t{4} << i) == lanes) return windows[i].start.empty() ? nullptr : &windows[i];
+    }
+    return nullptr;
+  }
 };
 
 // U's row blend, its rounding to uQb.U and the EOTF ROM interpolation (FixedKernels::linear_of_upsampled): node y_i
