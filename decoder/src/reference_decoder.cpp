@@ -14,6 +14,8 @@
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -167,13 +169,15 @@ cv::Mat motion_contrast(const cv::Mat& previous_low_linear, const cv::Mat& alpha
 // (where s c would be inf * 0 = NaN).
 cv::Mat motion_weight(const cv::Mat& contrast, double sensitivity) {
   cv::Mat weight(contrast.size(), CV_64FC1);
-  for (int y = 0; y < contrast.rows; ++y) {
-    const double* c_row = contrast.ptr<double>(y);
-    double* w_row = weight.ptr<double>(y);
-    for (int x = 0; x < contrast.cols; ++x) {
-      w_row[x] = c_row[x] == 0.0 ? 1.0 : std::exp(-sensitivity * c_row[x]);
+  cv::parallel_for_(cv::Range(0, contrast.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const double* c_row = contrast.ptr<double>(y);
+      double* w_row = weight.ptr<double>(y);
+      for (int x = 0; x < contrast.cols; ++x) {
+        w_row[x] = c_row[x] == 0.0 ? 1.0 : std::exp(-sensitivity * c_row[x]);
+      }
     }
-  }
+  });
   return weight;
 }
 
@@ -254,43 +258,51 @@ PanelDrive drive_panel(const cv::Mat& wanted, const cv::Mat& previous_wanted, co
     out.unreachable = cv::Mat::zeros(size, CV_8UC3);
     out.previous_drive = previous_drive;
   }
-  for (int y = 0; y < size.height; ++y) {
-    const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
-    const cv::Vec3d* xp_row = history ? previous_wanted.ptr<cv::Vec3d>(y) : nullptr;
-    const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
-    cv::Vec3d* v_row = out.drive.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < size.width; ++x) {
-      for (int ch = 0; ch < 3; ++ch) {
-        const double x_t = x_row[x][ch];
-        const double x_prev = history ? xp_row[x][ch] : 0.0;
-        const PanelDriveSample sample = panel.drive(x_t, x_prev, history ? vp_row[x][ch] : 0.0, ch);
-        v_row[x][ch] = sample.v;
-        if (!history) continue;
-        out.target.ptr<cv::Vec3d>(y)[x][ch] = sample.target;
-        if (!sample.reachable) {
-          ++out.unreachable_count;
-          out.unreachable.ptr<cv::Vec3b>(y)[x][ch] = 255;
-          out.shortfall.ptr<cv::Vec3d>(y)[x][ch] = x_t - sample.contributed;
-          out.contributed.ptr<cv::Vec3d>(y)[x][ch] = sample.contributed;
+  // Rows on OpenCV's threads: every sample's drive is computed alone (the same doubles for any split); the
+  // unreachable samples are counted per row and added up in row order.
+  std::vector<std::size_t> unreachable_per_row(static_cast<std::size_t>(size.height), 0);
+  cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
+      const cv::Vec3d* xp_row = history ? previous_wanted.ptr<cv::Vec3d>(y) : nullptr;
+      const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
+      cv::Vec3d* v_row = out.drive.ptr<cv::Vec3d>(y);
+      for (int x = 0; x < size.width; ++x) {
+        for (int ch = 0; ch < 3; ++ch) {
+          const double x_t = x_row[x][ch];
+          const double x_prev = history ? xp_row[x][ch] : 0.0;
+          const PanelDriveSample sample = panel.drive(x_t, x_prev, history ? vp_row[x][ch] : 0.0, ch);
+          v_row[x][ch] = sample.v;
+          if (!history) continue;
+          out.target.ptr<cv::Vec3d>(y)[x][ch] = sample.target;
+          if (!sample.reachable) {
+            ++unreachable_per_row[static_cast<std::size_t>(y)];
+            out.unreachable.ptr<cv::Vec3b>(y)[x][ch] = 255;
+            out.shortfall.ptr<cv::Vec3d>(y)[x][ch] = x_t - sample.contributed;
+            out.contributed.ptr<cv::Vec3d>(y)[x][ch] = sample.contributed;
+          }
         }
       }
     }
-  }
+  });
+  for (const std::size_t count : unreachable_per_row) out.unreachable_count += count;
   out.codes = quantise(out.drive, output_bits);
 
   const int top = max_code(output_bits);
   out.emitted_linear.create(size, CV_64FC3);
-  for (int y = 0; y < size.height; ++y) {
-    const cv::Vec3w* q_row = out.codes.ptr<cv::Vec3w>(y);
-    const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
-    cv::Vec3d* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < size.width; ++x) {
-      for (int ch = 0; ch < 3; ++ch) {
-        const auto previous_code = history ? static_cast<std::uint16_t>(std::lround(vp_row[x][ch] * top)) : 0;
-        e_row[x][ch] = emission(q_row[x][ch], previous_code, ch);
+  cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const cv::Vec3w* q_row = out.codes.ptr<cv::Vec3w>(y);
+      const cv::Vec3d* vp_row = history ? previous_drive.ptr<cv::Vec3d>(y) : nullptr;
+      cv::Vec3d* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);
+      for (int x = 0; x < size.width; ++x) {
+        for (int ch = 0; ch < 3; ++ch) {
+          const auto previous_code = history ? static_cast<std::uint16_t>(std::lround(vp_row[x][ch] * top)) : 0;
+          e_row[x][ch] = emission(q_row[x][ch], previous_code, ch);
+        }
       }
     }
-  }
+  });
   return out;
 }
 
@@ -298,13 +310,15 @@ PanelDrive drive_panel(const cv::Mat& wanted, const cv::Mat& previous_wanted, co
 // x_{t-1} = x_t and v_{t-1} = the held drive of x_t (M(v, v) = x_t^(1/gamma)), quantised as any shown drive.
 std::pair<cv::Mat, cv::Mat> held_history(const cv::Mat& wanted, const Panel& panel, int output_bits) {
   cv::Mat held_drive(wanted.size(), CV_64FC3);
-  for (int y = 0; y < wanted.rows; ++y) {
-    const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
-    cv::Vec3d* v_row = held_drive.ptr<cv::Vec3d>(y);
-    for (int x = 0; x < wanted.cols; ++x) {
-      for (int ch = 0; ch < 3; ++ch) v_row[x][ch] = panel.drive_from_linear(x_row[x][ch], ch);
+  cv::parallel_for_(cv::Range(0, wanted.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const cv::Vec3d* x_row = wanted.ptr<cv::Vec3d>(y);
+      cv::Vec3d* v_row = held_drive.ptr<cv::Vec3d>(y);
+      for (int x = 0; x < wanted.cols; ++x) {
+        for (int ch = 0; ch < 3; ++ch) v_row[x][ch] = panel.drive_from_linear(x_row[x][ch], ch);
+      }
     }
-  }
+  });
   return {wanted.clone(), dequantise(quantise(held_drive, output_bits), output_bits)};
 }
 

@@ -6,6 +6,8 @@
 // numerators as integers makes tap membership (|i - c| <= R) and integer centres exact.
 #include "trm/resample.hpp"
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -158,35 +160,41 @@ cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, d
   const std::vector<ClampedTaps> row_taps = clamped_gaussian_taps(full.rows, reduced_height, sigma);
 
   // Horizontal pass: every full row -> reduced_width samples.
+  // Both passes split their output rows over OpenCV's threads: each output sample is one sum in a fixed order, so the
+  // doubles do not depend on the split.
   cv::Mat horizontal(full.rows, reduced_width, full.type());
-  for (int y = 0; y < full.rows; ++y) {
-    const double* src = full.ptr<double>(y);
-    double* dst = horizontal.ptr<double>(y);
-    for (int x = 0; x < reduced_width; ++x) {
-      const ClampedTaps& taps = col_taps[static_cast<std::size_t>(x)];
-      for (int ch = 0; ch < channels; ++ch) {
-        double acc = 0.0;
-        for (std::size_t k = 0; k < taps.weight.size(); ++k) {
-          acc += taps.weight[k] * src[taps.index[k] * channels + ch];
+  cv::parallel_for_(cv::Range(0, full.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const double* src = full.ptr<double>(y);
+      double* dst = horizontal.ptr<double>(y);
+      for (int x = 0; x < reduced_width; ++x) {
+        const ClampedTaps& taps = col_taps[static_cast<std::size_t>(x)];
+        for (int ch = 0; ch < channels; ++ch) {
+          double acc = 0.0;
+          for (std::size_t k = 0; k < taps.weight.size(); ++k) {
+            acc += taps.weight[k] * src[taps.index[k] * channels + ch];
+          }
+          dst[x * channels + ch] = acc;
         }
-        dst[x * channels + ch] = acc;
       }
     }
-  }
+  });
 
   // Vertical pass: whole-row multiply-accumulate keeps memory access sequential.
   cv::Mat reduced(reduced_height, reduced_width, full.type());
   const int row_len = reduced_width * channels;
-  for (int y = 0; y < reduced_height; ++y) {
-    const ClampedTaps& taps = row_taps[static_cast<std::size_t>(y)];
-    double* dst = reduced.ptr<double>(y);
-    std::fill(dst, dst + row_len, 0.0);
-    for (std::size_t k = 0; k < taps.weight.size(); ++k) {
-      const double w = taps.weight[k];
-      const double* src = horizontal.ptr<double>(taps.index[k]);
-      for (int i = 0; i < row_len; ++i) dst[i] += w * src[i];
+  cv::parallel_for_(cv::Range(0, reduced_height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const ClampedTaps& taps = row_taps[static_cast<std::size_t>(y)];
+      double* dst = reduced.ptr<double>(y);
+      std::fill(dst, dst + row_len, 0.0);
+      for (std::size_t k = 0; k < taps.weight.size(); ++k) {
+        const double w = taps.weight[k];
+        const double* src = horizontal.ptr<double>(taps.index[k]);
+        for (int i = 0; i < row_len; ++i) dst[i] += w * src[i];
+      }
     }
-  }
+  });
   return reduced;
 }
 
@@ -200,27 +208,32 @@ cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height) {
   for (int x = 0; x < full_width; ++x) col_taps[static_cast<std::size_t>(x)] = bilinear_tap(x, full_width, reduced.cols);
 
   // Horizontal pass on every reduced row (as OpenCV does), then a vertical blend of two such rows.
+  // Each pass's output rows on OpenCV's threads (every sample computed alone: the same doubles for any split).
   cv::Mat horizontal(reduced.rows, full_width, reduced.type());
-  for (int y = 0; y < reduced.rows; ++y) {
-    const double* src = reduced.ptr<double>(y);
-    double* dst = horizontal.ptr<double>(y);
-    for (int x = 0; x < full_width; ++x) {
-      const BilinearTap& t = col_taps[static_cast<std::size_t>(x)];
-      const double* a = src + t.i0 * channels;
-      const double* b = src + t.i1 * channels;
-      for (int ch = 0; ch < channels; ++ch) dst[x * channels + ch] = (1.0 - t.frac) * a[ch] + t.frac * b[ch];
+  cv::parallel_for_(cv::Range(0, reduced.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const double* src = reduced.ptr<double>(y);
+      double* dst = horizontal.ptr<double>(y);
+      for (int x = 0; x < full_width; ++x) {
+        const BilinearTap& t = col_taps[static_cast<std::size_t>(x)];
+        const double* a = src + t.i0 * channels;
+        const double* b = src + t.i1 * channels;
+        for (int ch = 0; ch < channels; ++ch) dst[x * channels + ch] = (1.0 - t.frac) * a[ch] + t.frac * b[ch];
+      }
     }
-  }
+  });
 
   cv::Mat full(full_height, full_width, reduced.type());
   const int row_len = full_width * channels;
-  for (int y = 0; y < full_height; ++y) {
-    const BilinearTap t = bilinear_tap(y, full_height, reduced.rows);
-    const double* a = horizontal.ptr<double>(t.i0);
-    const double* b = horizontal.ptr<double>(t.i1);
-    double* dst = full.ptr<double>(y);
-    for (int i = 0; i < row_len; ++i) dst[i] = (1.0 - t.frac) * a[i] + t.frac * b[i];
-  }
+  cv::parallel_for_(cv::Range(0, full_height), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const BilinearTap t = bilinear_tap(y, full_height, reduced.rows);
+      const double* a = horizontal.ptr<double>(t.i0);
+      const double* b = horizontal.ptr<double>(t.i1);
+      double* dst = full.ptr<double>(y);
+      for (int i = 0; i < row_len; ++i) dst[i] = (1.0 - t.frac) * a[i] + t.frac * b[i];
+    }
+  });
   return full;
 }
 

@@ -1,6 +1,8 @@
 // Transfer functions, link quantisation and luma (DESIGN §3).
 #include "trm/transfer.hpp"
 
+#include <opencv2/core/utility.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -31,11 +33,14 @@ template <typename F>
 cv::Mat map_elements(const cv::Mat& in, F f) {
   cv::Mat out(in.size(), in.type());
   const int row_len = in.cols * in.channels();
-  for (int y = 0; y < in.rows; ++y) {
-    const double* src = in.ptr<double>(y);
-    double* dst = out.ptr<double>(y);
-    for (int i = 0; i < row_len; ++i) dst[i] = f(src[i]);
-  }
+  // Rows on OpenCV's threads: every element is computed alone, so the doubles do not depend on the split.
+  cv::parallel_for_(cv::Range(0, in.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const double* src = in.ptr<double>(y);
+      double* dst = out.ptr<double>(y);
+      for (int i = 0; i < row_len; ++i) dst[i] = f(src[i]);
+    }
+  });
   return out;
 }
 

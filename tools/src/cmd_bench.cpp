@@ -191,8 +191,10 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   };
   const auto add = [&contenders, &size, &wanted](std::string name, const char* impl, FixedDecoderConfig c) {
     if (!wanted(name)) return;
-    const int threads =
-        std::string(impl) == "fixed" ? FixedStreamingDecoder(c).threads_for(cv::Size(size.width, size.height)) : 1;
+    // The reference splits its stages' rows over OpenCV's threads; the fixed-point frame decoder runs on one.
+    const int threads = std::string(impl) == "fixed"       ? FixedStreamingDecoder(c).threads_for(cv::Size(size.width, size.height))
+                        : std::string(impl) == "reference" ? cv::getNumThreads()
+                                                           : 1;
     contenders.push_back({std::move(name), threads,
                           [impl, c] {
                             std::shared_ptr<HeadsetDecoder> d = make_decoder(impl, c);
