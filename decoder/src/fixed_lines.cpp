@@ -133,7 +133,8 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
 }
 
 // DriveCodes in 32-bit lanes (DrivePlan::base32 ..): the bucket from a float's exponent and fraction, exact because
-// a value of 2^24 or more is converted shifted right by 5 (its top m + 1 bits kept, m = 7), and one below exactly.
+// a value of 2^24 or more (below 2^30) is converted shifted right by 6, below 2^24 and so without rounding, which keeps
+// its top m + 1 bits (m <= 17), and a smaller value is converted as it is.
 std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[maybe_unused]] std::size_t n,
                              [[maybe_unused]] const DrivePlan& p, [[maybe_unused]] std::uint16_t* out) {
   std::size_t s = 0;
@@ -154,7 +155,7 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   const auto exact_float = hn::Set(d, std::int32_t{1} << 24);
   const auto mantissa_mask = hn::Set(du, (std::uint32_t{1} << m) - 1);
   const auto exponent_bias = hn::Set(d, std::int32_t{127} + m - 1);
-  const auto five = hn::Set(d, std::int32_t{5});
+  const auto six = hn::Set(d, std::int32_t{6});
   const auto one = hn::Set(d, std::int32_t{1});
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
@@ -169,8 +170,8 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
     const auto x = hn::BitCast(d, hn::Combine(du, hn::TruncateTo(duh, hn::BitCast(du64, high)),
                                               hn::TruncateTo(duh, hn::BitCast(du64, low))));
     const auto large = hn::Not(hn::Lt(x, exact_float));
-    const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<5>(x), x)));
-    const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, five));
+    const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<6>(x), x)));
+    const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, six));
     const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 23 - m), mantissa_mask));
     const auto octave = hn::ShiftLeftSame(hn::Sub(exponent, exponent_bias), m);
     const auto bucket = hn::IfThenElse(hn::Lt(x, small), x, hn::Add(octave, top_bits));
@@ -815,7 +816,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
                       target.is_octave_segmented() && target.shape().rounding == fx::Quant::Rnd &&
                       !target.shape().output_signed && target.shape().input_bits <= 30 && l.bottom_region_bits >= 1 &&
                       rom.size() >= (static_cast<std::size_t>(target.shape().octaves) << l.segments_per_octave_log2) &&
-                      l.merge.size() >= static_cast<std::size_t>(l.width * l.width) &&
+                      l.merge.size() >= static_cast<std::size_t>(l.width * (l.width + 1)) &&  // the held row too
                       l.end_dark.size() == static_cast<std::size_t>(l.width) &&
                       l.end_bright.size() == static_cast<std::size_t>(l.width);
     if (fits) {
@@ -854,7 +855,7 @@ std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& 
       d.bucket_offset.push_back(bucket_start[static_cast<std::size_t>(i % 3)]);
       d.threshold_offset.push_back(threshold_start[static_cast<std::size_t>(i % 3)]);
     }
-    if (channels[0]->value_bits() <= 30 && d.mantissa_bits <= 18 && d.thresholds.size() < (std::size_t{1} << 30)) {
+    if (channels[0]->value_bits() <= 30 && d.mantissa_bits <= 17 && d.thresholds.size() < (std::size_t{1} << 30)) {
       const auto narrow = [](std::int64_t v) {
         return static_cast<std::int32_t>(std::clamp<std::int64_t>(v, INT32_MIN, INT32_MAX));
       };

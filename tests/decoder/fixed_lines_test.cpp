@@ -78,16 +78,16 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
     bool skip;
     int width;
   };
-  // 67 pixels: 201 samples per line, a tail after every vector width; r = 0.4 gives non-dyadic U weights; on the LCD
-  // the reduced frames take the line kernels up to the drive, which stays per sample. 66 and 68 pixels at r = 1/2
-  // and 1/4 divide evenly, so D's horizontal half takes its polyphase planes (33 and 17 columns: tails again).
+  // 67 pixels: 201 samples per line, a tail after every vector width; r = 0.4 gives non-dyadic U weights; the 8-bit
+  // LCD takes its drive kernel. 66 and 68 pixels at r = 1/2 and 1/4 divide evenly, so D's horizontal half takes its
+  // polyphase planes (33 and 17 columns: tails again; asserted below).
   const std::vector<Case> cases = {
       {"panorama", 0.5, "vive", 8, false, true, 67},  {"discs", 0.4, "rift", 10, false, true, 67},
       {"checker", 0.5, "vive", 8, true, false, 67},   {"text", 0.75, "vive", 8, false, true, 67},
       {"zoneplate", 0.25, "rift", 8, false, true, 67}, {"flash", 0.5, "vive", 10, false, true, 67},
       {"jitter", 0.5, "vive", 8, false, false, 67},  {"panorama", 0.5, "lcd", 8, false, true, 67},
       {"discs", 0.4, "lcd", 8, true, false, 67},     {"panorama", 0.5, "vive", 8, true, true, 66},
-      {"zoneplate", 0.25, "lcd", 10, false, false, 68},
+      {"zoneplate", 0.25, "lcd", 8, false, false, 68},
   };
   const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());
@@ -99,6 +99,10 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
       const auto frames = encode_sequence(scene_images(c.scene, c.width, 46, 6), link);
       FixedDecoderConfig config = fixed_config(link, c.panel, c.output_bits);
       config.skip_unneeded = c.skip;
+      if (c.width % 2 == 0) {
+        fixed_detail::FixedKernels kernels(config);
+        ASSERT_NE(kernels.geometry(cv::Size(c.width, 46)).gauss_columns.decimation, 0u) << c.scene << " polyphase";
+      }
       for (const bool planes : {true, false}) {
         expect_kernels_identical(frames, config, planes,
                                  std::string(hwy::TargetName(target)) + " " + c.scene + " r=" + std::to_string(c.r) +
@@ -337,12 +341,15 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
   values.push_back(std::int64_t{1} << 40);
   std::vector<std::uint16_t> expected(values.size());
   for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_code(values[s], static_cast<int>(s % 3));
-  // A ROM with thresholds at 2^k - 1 and 2^k for every k below 2^30: the last value of each octave has a code of its
-  // own, which a float conversion that rounded 2^k - 1 up to 2^k would miss.
+  // A ROM with thresholds at 2^k - 1, 2^k and at the second bucket of each octave, 2^k + 2^(k-7), for every k up to
+  // the index's 2^30: the last value of an octave and of its first bucket each have a code of their own, which a float
+  // conversion that rounded a run of ones up into the next bucket would miss (below 2^30 the shifted value must stay
+  // under 2^24).
   std::vector<std::int64_t> octave_ends{0};
   for (int k = 1; k < 30; ++k) {
     if ((std::int64_t{1} << k) - 1 > octave_ends.back()) octave_ends.push_back((std::int64_t{1} << k) - 1);
     octave_ends.push_back(std::int64_t{1} << k);
+    if (k >= 8) octave_ends.push_back((std::int64_t{1} << k) + (std::int64_t{1} << (k - 7)));
   }
   const fixed_detail::ThresholdIndex ends(octave_ends, 30);
   const std::optional<fixed_detail::DrivePlan> ends_plan = fixed_detail::drive_plan({&ends, &ends, &ends});
@@ -350,6 +357,9 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
   std::vector<std::int64_t> end_values;
   for (const std::int64_t t : octave_ends) {
     for (const std::int64_t v : {t - 2, t - 1, t, t + 1}) end_values.push_back(v);
+  }
+  for (const std::int64_t v : {(std::int64_t{1} << 30) - 1, (std::int64_t{1} << 30) - 32, std::int64_t{541065215}}) {
+    end_values.push_back(v);  // the top of the index, and 2^29 + 2^22 - 1 (bits 0-21 set)
   }
   std::vector<std::uint16_t> end_expected(end_values.size());
   for (std::size_t s = 0; s < end_values.size(); ++s) end_expected[s] = ends.search(end_values[s]);
@@ -367,6 +377,45 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
     fixed_detail::lines::drive_codes(end_values.data(), end_values.size(), *ends_plan, codes.data());
     for (std::size_t s = 0; s < end_values.size(); ++s) {
       ASSERT_EQ(codes[s], end_expected[s]) << hwy::TargetName(target) << " octave ends, value " << end_values[s];
+    }
+  }
+}
+
+// U's column blend through its windows (a vector's taps within one vector of row samples, permuted) and through the
+// gather, against the blend's formula, at a headset width and a narrow one with tails, on every instruction set.
+TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
+  std::mt19937_64 random(31);
+  for (const auto& [width, r] : {std::pair{2160, 0.5}, std::pair{67, 0.25}, std::pair{67, 0.75}}) {
+    fixed_detail::FixedKernels kernels(fixed_config(link_config(r), "vive"));
+    const fixed_detail::Geometry& g = kernels.geometry(cv::Size(width, 24));
+    const fixed_detail::ColumnBlendPlan& plan = g.column_blend;
+    ASSERT_FALSE(plan.left.empty());
+    fixed_detail::ColumnBlendPlan gather_copy = plan;
+    gather_copy.windows = {};
+    const fixed_detail::ColumnBlendPlan& gather_only = gather_copy;
+    std::vector<std::uint16_t> row(3 * static_cast<std::size_t>(g.reduced.width));
+    for (std::uint16_t& code : row) code = static_cast<std::uint16_t>(random() % 256);
+    const std::size_t n = plan.left.size();
+    std::vector<std::uint32_t> expected(n);
+    for (std::size_t s = 0; s < n; ++s) {
+      expected[s] = (plan.unit - plan.upper[s]) * row[static_cast<std::size_t>(plan.left[s])] +
+                    plan.upper[s] * row[static_cast<std::size_t>(plan.right[s])];
+    }
+    bool some_windows = false;
+    for (const auto& w : plan.windows) some_windows = some_windows || !w.start.empty();
+    if (width == 2160) {
+      EXPECT_TRUE(some_windows) << "r = 1/2 at a headset width takes the windows on some width";
+    }
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      for (const fixed_detail::ColumnBlendPlan* p : {&plan, &gather_only}) {
+        std::vector<std::uint32_t> out(n);
+        fixed_detail::lines::blend_columns(row.data(), *p, n, out.data());
+        for (std::size_t s = 0; s < n; ++s) {
+          ASSERT_EQ(out[s], expected[s]) << hwy::TargetName(target) << " width " << width << " r " << r
+                                         << (p == &plan ? " windows" : " gather") << " sample " << s;
+        }
+      }
     }
   }
 }
