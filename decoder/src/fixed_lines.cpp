@@ -132,6 +132,24 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   }
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// ThresholdIndex::search over a vector, either lane width: the bucket (x itself below 2^m, else its octave, the
+// leading-one position less m - 1, and the m bits below the leading one), the code at its lower end, then the few
+// thresholds inside it. Returns the codes plus the channels' threshold offsets, which the caller subtracts.
+template <class D, typename T>
+HWY_INLINE hn::Vec<D> IndexSearch(D d, hn::Vec<D> x, hn::Vec<D> octave, hn::Vec<D> top_bits, int m, int steps,
+                                  const T* base, const T* bucket_offset, const T* thresholds) {
+  const auto one = hn::Set(d, T{1});
+  const auto bucket = hn::IfThenElse(hn::Lt(x, hn::Set(d, T{1} << m)), x, hn::Add(hn::ShiftLeftSame(octave, m), top_bits));
+  auto k = hn::GatherIndex(d, base, hn::Add(bucket, hn::LoadU(d, bucket_offset)));
+  for (int i = 0; i < steps; ++i) {
+    const auto threshold = hn::GatherIndex(d, thresholds, hn::Add(k, one));
+    k = hn::Add(k, hn::IfThenZeroElse(hn::Lt(x, threshold), one));
+  }
+  return k;
+}
+#endif
+
 // DriveCodes in 32-bit lanes (DrivePlan::base32 ..): the bucket from a float's exponent and fraction, exact because
 // a value of 2^24 or more (below 2^30) is converted shifted right by 6, below 2^24 and so without rounding, which keeps
 // its top m + 1 bits (m <= 17), and a smaller value is converted as it is.
@@ -151,12 +169,10 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   const int m = p.mantissa_bits;
   const auto zero64 = hn::Zero(d64);
   const auto limit64 = hn::Set(d64, p.value_limit);
-  const auto small = hn::Set(d, std::int32_t{1} << m);
   const auto exact_float = hn::Set(d, std::int32_t{1} << 24);
   const auto mantissa_mask = hn::Set(du, (std::uint32_t{1} << m) - 1);
   const auto exponent_bias = hn::Set(d, std::int32_t{127} + m - 1);
   const auto six = hn::Set(d, std::int32_t{6});
-  const auto one = hn::Set(d, std::int32_t{1});
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
   for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
@@ -173,13 +189,8 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
     const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<6>(x), x)));
     const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, six));
     const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 23 - m), mantissa_mask));
-    const auto octave = hn::ShiftLeftSame(hn::Sub(exponent, exponent_bias), m);
-    const auto bucket = hn::IfThenElse(hn::Lt(x, small), x, hn::Add(octave, top_bits));
-    auto k = hn::GatherIndex(d, p.base32.data(), hn::Add(bucket, hn::LoadU(d, p.bucket_offset32.data() + phase)));
-    for (int i = 0; i < p.steps; ++i) {
-      const auto threshold = hn::GatherIndex(d, p.thresholds32.data(), hn::Add(k, one));
-      k = hn::Add(k, hn::IfThenZeroElse(hn::Lt(x, threshold), one));
-    }
+    const auto k = IndexSearch(d, x, hn::Sub(exponent, exponent_bias), top_bits, m, p.steps, p.base32.data(),
+                               p.bucket_offset32.data() + phase, p.thresholds32.data());
     const auto code = hn::Sub(k, hn::LoadU(d, p.threshold_offset32.data() + phase));
     hn::StoreU(hn::DemoteTo(d16, code), d16, out + s);
   }
@@ -200,14 +211,12 @@ void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, s
   const hn::Rebind<double, decltype(d)> df;
   const std::size_t lanes = hn::Lanes(d);
   const int m = p.mantissa_bits;
-  const auto small = hn::Set(d, std::int64_t{1} << m);
   const auto limit = hn::Set(d, p.value_limit);
   const auto zero = hn::Zero(d);
   const auto mantissa_mask = hn::Set(du, (std::uint64_t{1} << m) - 1);
   // A double holds x < 2^53 exactly: its exponent is x's leading-one position and the top m bits of its fraction are
   // the m bits below it, which is the bucket the scalar index computes with a leading-zero count.
   const auto exponent_bias = hn::Set(d, std::int64_t{1023} + m - 1);
-  const auto one = hn::Set(d, std::int64_t{1});
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
   for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
@@ -219,13 +228,8 @@ void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, s
     const auto bits = hn::BitCast(du, hn::ConvertTo(df, x));
     const auto exponent = hn::BitCast(d, hn::ShiftRight<52>(bits));
     const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 52 - m), mantissa_mask));
-    const auto octave = hn::ShiftLeftSame(hn::Sub(exponent, exponent_bias), m);
-    const auto bucket = hn::IfThenElse(hn::Lt(x, small), x, hn::Add(octave, top_bits));
-    auto k = hn::GatherIndex(d, p.base.data(), hn::Add(bucket, hn::LoadU(d, p.bucket_offset.data() + phase)));
-    for (int i = 0; i < p.steps; ++i) {
-      const auto threshold = hn::GatherIndex(d, p.thresholds.data(), hn::Add(k, one));
-      k = hn::Add(k, hn::IfThenZeroElse(hn::Lt(x, threshold), one));
-    }
+    const auto k = IndexSearch(d, x, hn::Sub(exponent, exponent_bias), top_bits, m, p.steps, p.base.data(),
+                               p.bucket_offset.data() + phase, p.thresholds.data());
     const auto code = hn::Sub(k, hn::LoadU(d, p.threshold_offset.data() + phase));
     HWY_ALIGN std::int64_t wide[DrivePlan::kMaxLanes];
     hn::Store(code, d, wide);
