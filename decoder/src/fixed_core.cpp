@@ -212,8 +212,14 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
   const bool whole_line = line_values(out);
   if (whole_line) scratch.shown.resize(n);
   const std::optional<MotionPlan>& motion = kernels_.line_plans().motion;
-  if (whole_line && motion && residual_row != nullptr && !residual_zero) {
-    // Eqs. 4-6 over the line: w per pixel (1 on a static line, as reduced_pixel takes it), then alpha'.
+  if (whole_line && motion && (residual_row != nullptr || residual_zero)) {
+    // Eqs. 4-6 over the line: w per pixel (1 on a static line, as reduced_pixel takes it), then alpha'. A line whose
+    // stored residual is all zero takes the same kernels over zeros: w rho = 0 leaves clamp(alpha), what
+    // clamp_alpha gives, and w still counts towards the mean-weight statistic.
+    if (residual_zero) {
+      if (scratch.zero_residual.size() != n) scratch.zero_residual.assign(n, 0);
+      residual_row = scratch.zero_residual.data();
+    }
     const auto pixels = static_cast<std::size_t>(g.full.width);
     scratch.weight.resize(pixels);
     MotionTally m;

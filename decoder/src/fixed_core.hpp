@@ -106,6 +106,7 @@ struct LineScratch {
   std::vector<Raw> rho;          // a full frame's beta - shown
   std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
   std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho)
+  std::vector<std::int32_t> zero_residual;  // the residual of a line the store holds all zero (DESIGN §7 skip)
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.

@@ -1,0 +1,104 @@
+// One whole view of the streaming fixed-point decoder at a headset size (2160x1200, r = 1/2, panorama, drive codes
+// only: what `trm bench` calls `fixed`), full and reduced views timed apart, on 1 and 2 threads (bands of output
+// lines), OLED and LCD. Items are output pixels, so items_per_second reads as pixels per second. Each iteration decodes
+// a full view and the reduced view after it; the timed one is the argument's, the other runs with the timer paused
+// (a reduced view needs the full view's stores).
+#include "trm/encoder.hpp"
+#include "trm/fixed_decoder.hpp"
+#include "trm/scene.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace trm;
+
+constexpr int kWidth = 2160;
+constexpr int kHeight = 1200;
+
+EncoderConfig link_config() {
+  EncoderConfig link;
+  link.reduction = 0.5;
+  return link;
+}
+
+const std::vector<LinkFrame>& pair_of_views() {
+  static const std::vector<LinkFrame> views = [] {
+    SceneParams params;
+    params.width = kWidth;
+    params.height = kHeight;
+    params.supersample = 1;
+    const auto scene = make_scene("panorama", params);
+    const TrmEncoder encoder(link_config());
+    return std::vector<LinkFrame>{encoder.encode(scene->linear_frame(0), 0, 0),
+                                  encoder.encode(scene->linear_frame(1), 1, 0)};
+  }();
+  return views;
+}
+
+// Args: timed view (0 = full, 1 = reduced), threads, panel (0 = vive OLED, 1 = lcd).
+void BM_DecodeView(benchmark::State& state) {
+  const std::vector<LinkFrame>& views = pair_of_views();
+  FixedDecoderConfig config;
+  config.decoder.link = link_config();
+  config.decoder.panel = parse_panel(state.range(2) == 0 ? "vive" : "lcd");
+  config.report_planes = false;
+  config.threads = static_cast<int>(state.range(1));
+  FixedStreamingDecoder decoder(config);
+  const bool timed_reduced = state.range(0) != 0;
+  for (auto _ : state) {
+    if (timed_reduced) state.PauseTiming();
+    benchmark::DoNotOptimize(decoder.decode(views[0]));
+    if (timed_reduced) {
+      state.ResumeTiming();
+    } else {
+      state.PauseTiming();
+    }
+    benchmark::DoNotOptimize(decoder.decode(views[1]));
+    if (!timed_reduced) state.ResumeTiming();
+  }
+  state.SetItemsProcessed(state.iterations() * kWidth * kHeight);
+  state.SetLabel(std::string(timed_reduced ? "reduced" : "full") + " view, " + (state.range(2) == 0 ? "vive" : "lcd") +
+                 ", " + std::to_string(state.range(1)) + " thread(s)");
+}
+BENCHMARK(BM_DecodeView)
+    ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+namespace {
+
+// A fresh decoder's first views (its tables, geometry and frame stores come with them), as `trm bench` times each
+// repeat: Args: view (0-3: full, reduced, full, reduced), threads.
+void BM_FreshDecoderView(benchmark::State& state) {
+  const std::vector<LinkFrame>& views = pair_of_views();
+  FixedDecoderConfig config;
+  config.decoder.link = link_config();
+  config.decoder.panel = parse_panel("vive");
+  config.report_planes = false;
+  config.threads = static_cast<int>(state.range(1));
+  const int timed = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    state.PauseTiming();
+    {
+      FixedStreamingDecoder decoder(config);
+      for (int v = 0; v <= timed; ++v) {
+        if (v == timed) state.ResumeTiming();
+        LinkFrame view = views[static_cast<std::size_t>(v % 2)];
+        view.meta.index = v;
+        benchmark::DoNotOptimize(decoder.decode(view));
+      }
+      state.PauseTiming();
+    }
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(state.iterations() * kWidth * kHeight);
+}
+BENCHMARK(BM_FreshDecoderView)->ArgsProduct({{0, 1, 2, 3, 5, 7, 9}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
