@@ -177,19 +177,12 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   } else {
     emit_line(out, eye, y, scratch.shown.data(), nullptr);
   }
-  for (std::size_t s = 0; s < n; ++s) {
-    if (rho[s] == 0) {
-      residual_row[s] = 0;
-      continue;
-    }
-    const StoredResidual stored = kernels_.store_residual(rho[s]);
-    residual_row[s] = static_cast<std::int32_t>(stored.value);
-    t.counts.residual_saturated += stored.saturated ? 1 : 0;
-    t.counts.residual_rounded += stored.rounded ? 1 : 0;
-    const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
-    t.residual_abs_sum += magnitude;
-    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
-  }
+  ResidualTally stored;
+  lines::store_residuals(rho, n, kernels_, residual_row, stored);
+  t.counts.residual_saturated += stored.saturated;
+  t.counts.residual_rounded += stored.rounded;
+  t.residual_abs_sum += stored.abs_sum;
+  t.residual_abs_max = std::max(t.residual_abs_max, stored.abs_max);
 }
 
 void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,

@@ -651,6 +651,37 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
   for (; s < n; ++s) shown[s] = weighted_scalar(alpha[s], weight[s / 3], residual[s], kernels, tally);
 }
 
+inline std::int32_t stored_scalar(std::int64_t rho, const FixedKernels& kernels, ResidualTally& tally) {
+  if (rho == 0) return 0;
+  const StoredResidual stored = kernels.store_residual(rho);
+  tally.saturated += stored.saturated ? 1 : 0;
+  tally.rounded += stored.rounded ? 1 : 0;
+  const std::int64_t magnitude = stored.value < 0 ? -stored.value : stored.value;
+  tally.abs_sum += magnitude;
+  tally.abs_max = std::max(tally.abs_max, magnitude);
+  return static_cast<std::int32_t>(stored.value);
+}
+
+void StoreResiduals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                    ResidualTally& tally) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::Rebind<std::int32_t, decltype(d)> d32;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto zero32 = hn::Zero(d32);
+  for (; s + lanes <= n; s += lanes) {
+    if (hn::AllTrue(d, hn::Eq(hn::LoadU(d, rho + s), zero))) {
+      hn::StoreU(zero32, d32, stored + s);
+      continue;
+    }
+    for (std::size_t i = 0; i < lanes; ++i) stored[s + i] = stored_scalar(rho[s + i], kernels, tally);
+  }
+#endif
+  for (; s < n; ++s) stored[s] = stored_scalar(rho[s], kernels, tally);
+}
+
 const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
 
 }  // namespace HWY_NAMESPACE
@@ -979,6 +1010,7 @@ HWY_EXPORT(GaussianRows);
 HWY_EXPORT(LcdDrive);
 HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
+HWY_EXPORT(StoreResiduals);
 HWY_EXPORT(TargetName);
 
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
@@ -1017,6 +1049,10 @@ void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weigh
                             std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int64_t* shown,
                             MotionTally& tally) {
   HWY_DYNAMIC_DISPATCH(AddWeightedResiduals)(alpha, weight, residual, n, plan, kernels, shown, tally);
+}
+void store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                     ResidualTally& tally) {
+  HWY_DYNAMIC_DISPATCH(StoreResiduals)(rho, n, kernels, stored, tally);
 }
 const char* target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 

@@ -141,6 +141,15 @@ struct MotionTally {
   std::int64_t residual_abs_max = 0;
 };
 
+// What the residual store of a line adds to the frame's tally (FixedStageCounts::residual_saturated and
+// residual_rounded, FrameTally::residual_abs_sum and residual_abs_max).
+struct ResidualTally {
+  std::uint64_t saturated = 0;
+  std::uint64_t rounded = 0;
+  std::int64_t abs_sum = 0;
+  std::int64_t abs_max = 0;
+};
+
 // The LCD drive (FixedKernels::lcd_drive after the eye's first frame, and emit's frame-store update): the target
 // m = ((x_t + x_{t-1}) / 2)^(1/gamma) through the octave-segmented ROM, the binary search over the merge table's row
 // v_{t-1}, and the unreachable ends.
@@ -219,6 +228,10 @@ void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std
 void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
                             std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int64_t* shown,
                             MotionTally& tally);
+// The residual store of a line: FixedKernels::store_residual of each rho into `stored`; a vector of zeros (beta
+// within [0, 1], the common case) stores zeros without the stage function.
+void store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                     ResidualTally& tally);
 // The instruction set the kernels dispatch to on this CPU (e.g. "AVX3", "AVX2", "SSE4").
 const char* target_name();
 

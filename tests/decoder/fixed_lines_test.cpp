@@ -186,6 +186,59 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
   }
 }
 
+// The residual store over a line against FixedKernels::store_residual sample by sample, at the default residual
+// format and at a narrow one (sQ1.6) where rho both rounds and saturates; runs of zeros as long as a vector and
+// isolated non-zero samples, on every instruction set.
+TEST(FixedLines, ResidualStoreKernelGivesTheStageFunctionsBits) {
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  for (const bool narrow : {false, true}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5), "vive");
+    if (narrow) {
+      config.residual = {1, 6, true, fx::Quant::Rnd, fx::Overflow::Sat};
+    }
+    const fixed_detail::FixedKernels kernels(config);
+    const std::int64_t one = kernels.one();
+    constexpr std::size_t kSamples = 3 * 203;
+    std::mt19937_64 random(11);
+    std::uniform_int_distribution<std::int64_t> rho_value(-one, one);
+    std::vector<std::int64_t> rho(kSamples, 0);
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      if ((s / 40) % 2 == 1 || s % 17 == 0) rho[s] = rho_value(random);  // zero runs between non-zero stretches
+    }
+    rho[100] = one;
+    rho[101] = -one;
+    rho[102] = 1;
+    rho[103] = -1;
+    std::vector<std::int32_t> expected(kSamples);
+    fixed_detail::ResidualTally expected_tally;
+    for (std::size_t s = 0; s < kSamples; ++s) {
+      const fixed_detail::StoredResidual stored = kernels.store_residual(rho[s]);
+      expected[s] = static_cast<std::int32_t>(stored.value);
+      expected_tally.saturated += stored.saturated ? 1 : 0;
+      expected_tally.rounded += stored.rounded ? 1 : 0;
+      const std::int64_t magnitude = stored.value < 0 ? -stored.value : stored.value;
+      expected_tally.abs_sum += magnitude;
+      expected_tally.abs_max = std::max(expected_tally.abs_max, magnitude);
+    }
+    if (narrow) {
+      EXPECT_GT(expected_tally.saturated, 0u) << "the operands reach the narrow store's saturation";
+      EXPECT_GT(expected_tally.rounded, 0u) << "the operands reach the narrow store's rounding";
+    }
+    for (const std::int64_t target : targets) {
+      const TargetMock mock(target);
+      const std::string where = std::string(hwy::TargetName(target)) + (narrow ? " sQ1.6" : " default");
+      std::vector<std::int32_t> stored(kSamples, 12345);
+      fixed_detail::ResidualTally tally;
+      fixed_detail::lines::store_residuals(rho.data(), kSamples, kernels, stored.data(), tally);
+      for (std::size_t s = 0; s < kSamples; ++s) ASSERT_EQ(stored[s], expected[s]) << where << " sample " << s;
+      EXPECT_EQ(tally.saturated, expected_tally.saturated) << where;
+      EXPECT_EQ(tally.rounded, expected_tally.rounded) << where;
+      EXPECT_EQ(tally.abs_sum, expected_tally.abs_sum) << where;
+      EXPECT_EQ(tally.abs_max, expected_tally.abs_max) << where;
+    }
+  }
+}
+
 // D's kernels against the rounding they name (fx::rounded_shift, half to even and half up) on random tap slots, a
 // third of them with weights that leave exact ties, on every instruction set.
 TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
