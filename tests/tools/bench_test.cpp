@@ -52,6 +52,14 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
                                 "rss_before_mib"}) {
         expect_positive(d[field], name + " " + field);
       }
+      // The working memory is the peak less the resident set before: within [0, peak], and its ratio to the
+      // resource report's memory is that quotient.
+      ASSERT_TRUE(d["working_mib"].is_number()) << name;
+      const double working = d["working_mib"].get<double>();
+      EXPECT_GE(working, 0.0) << name;
+      EXPECT_LE(working, d["peak_rss_mib"].get<double>()) << name;
+      EXPECT_DOUBLE_EQ(d["working_over_hw_report"].get<double>(),
+                       working / r["hw_report_memory"]["total_mib"].get<double>()) << name;
       for (const char* hz : {"90", "120", "144"}) expect_positive(d["realtime_factor"][hz], name + " RT " + hz);
       ASSERT_EQ(d["repeat_seconds"].size(), 2u) << name;
       for (const nlohmann::json& s : d["repeat_seconds"]) expect_positive(s, name + " repeat");
