@@ -39,15 +39,20 @@ const std::vector<LinkFrame>& pair_of_views() {
   return views;
 }
 
+// What `trm bench` calls `fixed`: drive codes only, in bands of output lines on `threads` threads.
+FixedDecoderConfig codes_only(const char* panel, std::int64_t threads) {
+  FixedDecoderConfig config;
+  config.decoder.link = link_config();
+  config.decoder.panel = parse_panel(panel);
+  config.report_planes = false;
+  config.threads = static_cast<int>(threads);
+  return config;
+}
+
 // Args: timed view (0 = full, 1 = reduced), threads, panel (0 = vive OLED, 1 = lcd).
 void BM_DecodeView(benchmark::State& state) {
   const std::vector<LinkFrame>& views = pair_of_views();
-  FixedDecoderConfig config;
-  config.decoder.link = link_config();
-  config.decoder.panel = parse_panel(state.range(2) == 0 ? "vive" : "lcd");
-  config.report_planes = false;
-  config.threads = static_cast<int>(state.range(1));
-  FixedStreamingDecoder decoder(config);
+  FixedStreamingDecoder decoder(codes_only(state.range(2) == 0 ? "vive" : "lcd", state.range(1)));
   const bool timed_reduced = state.range(0) != 0;
   // A pair before the timing: the decoder's geometry, stores and output spares exist, as in a long run.
   benchmark::DoNotOptimize(decoder.decode(views[0]));
@@ -72,19 +77,11 @@ BENCHMARK(BM_DecodeView)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-}  // namespace
-
-namespace {
-
 // A fresh decoder's first views (its tables, geometry and frame stores come with them), as `trm bench` times each
 // repeat: Args: view (0, 1, 2, ..., 9: the decoder's first, second, ... view; even: full, odd: reduced), threads.
 void BM_FreshDecoderView(benchmark::State& state) {
   const std::vector<LinkFrame>& views = pair_of_views();
-  FixedDecoderConfig config;
-  config.decoder.link = link_config();
-  config.decoder.panel = parse_panel("vive");
-  config.report_planes = false;
-  config.threads = static_cast<int>(state.range(1));
+  const FixedDecoderConfig config = codes_only("vive", state.range(1));
   const int timed = static_cast<int>(state.range(0));
   for (auto _ : state) {
     state.PauseTiming();

@@ -179,10 +179,7 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   }
   ResidualTally stored;
   lines::store_residuals(rho, n, kernels_, residual_row, stored);
-  t.counts.residual_saturated += stored.saturated;
-  t.counts.residual_rounded += stored.rounded;
-  t.residual_abs_sum += stored.abs_sum;
-  t.residual_abs_max = std::max(t.residual_abs_max, stored.abs_max);
+  t.add(stored);
 }
 
 void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,
@@ -293,11 +290,9 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, int y, int x,
     const StoredResidual stored = kernels_.store_residual(s.rho + shortfall);
     residual_row[3 * x + ch] = static_cast<std::int32_t>(stored.value);
     tap(out, Stage::Residual, y, x, ch, stored.value);
-    t.counts.residual_saturated += stored.saturated ? 1 : 0;
-    t.counts.residual_rounded += stored.rounded ? 1 : 0;
-    const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
-    t.residual_abs_sum += magnitude;
-    t.residual_abs_max = std::max(t.residual_abs_max, magnitude);
+    ResidualTally residual;
+    residual.add(stored);
+    t.add(residual);
   }
 }
 

@@ -24,6 +24,13 @@ struct FrameTally {
   Raw residual_abs_sum = 0;      // in residual format LSBs
   Raw residual_abs_max = 0;
 
+  // The residual store's part.
+  void add(const ResidualTally& r) {
+    counts.residual_saturated += r.saturated;
+    counts.residual_rounded += r.rounded;
+    residual_abs_sum += r.abs_sum;
+    residual_abs_max = std::max(residual_abs_max, r.abs_max);
+  }
   // The tally of two parts of one frame (bands of lines decoded apart).
   FrameTally& operator+=(const FrameTally& t) {
     counts += t.counts;

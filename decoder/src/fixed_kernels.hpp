@@ -65,6 +65,23 @@ struct StoredResidual {
   bool rounded = false;
 };
 
+// What the residual store adds to the frame's tally (FixedStageCounts::residual_saturated and residual_rounded,
+// FrameTally::residual_abs_sum and residual_abs_max), sample by sample or a line at a time.
+struct ResidualTally {
+  std::uint64_t saturated = 0;
+  std::uint64_t rounded = 0;
+  Raw abs_sum = 0;
+  Raw abs_max = 0;
+
+  void add(const StoredResidual& stored) {
+    saturated += stored.saturated ? 1 : 0;
+    rounded += stored.rounded ? 1 : 0;
+    const Raw magnitude = stored.value < 0 ? -stored.value : stored.value;
+    abs_sum += magnitude;
+    abs_max = std::max(abs_max, magnitude);
+  }
+};
+
 // LCD drive of one channel sample (Eq. 7 inverse).
 struct LcdSample {
   std::uint16_t code = 0;

@@ -654,11 +654,7 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
 inline std::int32_t stored_scalar(std::int64_t rho, const FixedKernels& kernels, ResidualTally& tally) {
   if (rho == 0) return 0;
   const StoredResidual stored = kernels.store_residual(rho);
-  tally.saturated += stored.saturated ? 1 : 0;
-  tally.rounded += stored.rounded ? 1 : 0;
-  const std::int64_t magnitude = stored.value < 0 ? -stored.value : stored.value;
-  tally.abs_sum += magnitude;
-  tally.abs_max = std::max(tally.abs_max, magnitude);
+  tally.add(stored);
   return static_cast<std::int32_t>(stored.value);
 }
 

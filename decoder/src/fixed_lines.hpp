@@ -141,14 +141,7 @@ struct MotionTally {
   std::int64_t residual_abs_max = 0;
 };
 
-// What the residual store of a line adds to the frame's tally (FixedStageCounts::residual_saturated and
-// residual_rounded, FrameTally::residual_abs_sum and residual_abs_max).
-struct ResidualTally {
-  std::uint64_t saturated = 0;
-  std::uint64_t rounded = 0;
-  std::int64_t abs_sum = 0;
-  std::int64_t abs_max = 0;
-};
+struct ResidualTally;  // fixed_kernels.hpp
 
 // The LCD drive (FixedKernels::lcd_drive after the eye's first frame, and emit's frame-store update): the target
 // m = ((x_t + x_{t-1}) / 2)^(1/gamma) through the octave-segmented ROM, the binary search over the merge table's row
