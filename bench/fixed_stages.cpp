@@ -291,9 +291,8 @@ void BM_LineCompensate(benchmark::State& state) {
   std::vector<Raw> shown(codes.size()), rho(codes.size());
   const auto& plans = kernels.line_plans();
   for (auto _ : state) {
-    benchmark::DoNotOptimize(trm::fixed_detail::lines::compensate(codes.data(), low.data(), codes.size(),
-                                                                  plans.code_rom.data(), plans.one, shown.data(),
-                                                                  rho.data()));
+    benchmark::DoNotOptimize(trm::fixed_detail::lines::compensate(codes.data(), low.data(), codes.size(), plans,
+                                                                  shown.data(), rho.data()));
     benchmark::DoNotOptimize(rho.data());
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);

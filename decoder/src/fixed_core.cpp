@@ -164,8 +164,8 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
   // store, whose rounding and saturation act only where rho is not zero.
   scratch.shown.resize(n);
   scratch.rho.resize(n);
-  const std::uint64_t clipped = lines::compensate(codes_row, scratch.first.data(), n, plans.code_rom.data(), plans.one,
-                                                  scratch.shown.data(), scratch.rho.data());
+  const std::uint64_t clipped = lines::compensate(codes_row, scratch.first.data(), n, plans, scratch.shown.data(),
+                                                  scratch.rho.data());
   FrameTally& t = out.tally;
   t.clipped += clipped;
   t.counts.beta_clipped += clipped;

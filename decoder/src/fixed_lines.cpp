@@ -173,6 +173,11 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   const auto mantissa_mask = hn::Set(du, (std::uint32_t{1} << m) - 1);
   const auto exponent_bias = hn::Set(d, std::int32_t{127} + m - 1);
   const auto six = hn::Set(d, std::int32_t{6});
+  const bool packed = !p.packed32.empty();
+  const auto* packed_words = reinterpret_cast<const std::int32_t*>(p.packed32.data());
+  const auto direct = hn::Set(d, std::int32_t{1} << m);
+  const auto one32 = hn::Set(du, 1u);
+  const auto offset_mask = hn::Set(du, packed ? (std::uint32_t{1} << p.offset_bits) - 1 : 0u);
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
   for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
@@ -189,8 +194,21 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
     const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<6>(x), x)));
     const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, six));
     const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 23 - m), mantissa_mask));
-    const auto k = IndexSearch(d, x, hn::Sub(exponent, exponent_bias), top_bits, m, p.steps, p.base32.data(),
-                               p.bucket_offset32.data() + phase, p.thresholds32.data());
+    const auto octave = hn::Sub(exponent, exponent_bias);
+    if (packed) {
+      // One gather (DrivePlan::packed32): x's bits below its bucket's lower end against the next threshold's offset.
+      const auto small = hn::Lt(x, direct);
+      const auto bucket = hn::IfThenElse(small, x, hn::Add(hn::ShiftLeftSame(octave, m), top_bits));
+      const auto word = hn::BitCast(du, hn::GatherIndex(d, packed_words, hn::Add(bucket, hn::LoadU(d, p.bucket_offset32.data() + phase))));
+      const auto below_bits = hn::Sub(hn::Shl(one32, hn::BitCast(du, hn::Max(hn::Sub(octave, hn::BitCast(d, one32)), hn::Zero(d)))), one32);
+      const auto low = hn::IfThenZeroElse(hn::RebindMask(du, small), hn::And(hn::BitCast(du, x), below_bits));
+      const auto k = hn::ShiftRightSame(word, p.offset_bits);
+      const auto code = hn::Add(k, hn::IfThenZeroElse(hn::Lt(low, hn::And(word, offset_mask)), one32));
+      hn::StoreU(hn::DemoteTo(d16, hn::BitCast(d, code)), d16, out + s);
+      continue;
+    }
+    const auto k = IndexSearch(d, x, octave, top_bits, m, p.steps, p.base32.data(), p.bucket_offset32.data() + phase,
+                               p.thresholds32.data());
     const auto code = hn::Sub(k, hn::LoadU(d, p.threshold_offset32.data() + phase));
     hn::StoreU(hn::DemoteTo(d16, code), d16, out + s);
   }
@@ -239,8 +257,10 @@ void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, s
   for (; s < n; ++s) out[s] = drive_scalar(linear[s], s, p);
 }
 
-std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
-                         const std::int64_t* code_rom, std::int64_t one_value, std::int64_t* shown, std::int64_t* rho) {
+std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n, const FixedLinePlans& plans,
+                         std::int64_t* shown, std::int64_t* rho) {
+  const std::int64_t* code_rom = plans.code_rom.data();
+  const std::int64_t one_value = plans.one;
   std::uint64_t clipped = 0;
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
@@ -251,14 +271,28 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, one_value);
-  for (; s + lanes <= n; s += lanes) {
-    const auto code = hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(d32, hn::LoadU(d16, codes + s))));
-    const auto full = hn::GatherIndex(d, code_rom, code);
-    const auto beta = hn::Sub(hn::Add(full, full), hn::LoadU(d, low + s));
+  const auto split = [&](const auto full, std::size_t at) {
+    const auto beta = hn::Sub(hn::Add(full, full), hn::LoadU(d, low + at));
     const auto clamped = hn::Min(hn::Max(beta, zero), one);
     clipped += hn::CountTrue(d, hn::Not(hn::Eq(clamped, beta)));
-    hn::StoreU(clamped, d, shown + s);
-    hn::StoreU(hn::Sub(beta, clamped), d, rho + s);
+    hn::StoreU(clamped, d, shown + at);
+    hn::StoreU(hn::Sub(beta, clamped), d, rho + at);
+  };
+  if (!plans.code_rom32.empty()) {
+    // lin(E) of two vectors' samples by one gather of 32-bit words.
+    const hn::Repartition<std::int32_t, decltype(d)> di32;
+    const hn::Rebind<std::uint16_t, decltype(di32)> d16w;
+    const hn::Half<decltype(di32)> di32h;
+    for (; s + 2 * lanes <= n; s += 2 * lanes) {
+      const auto code = hn::BitCast(di32, hn::PromoteTo(hn::RebindToUnsigned<decltype(di32)>(), hn::LoadU(d16w, codes + s)));
+      const auto full = hn::GatherIndex(di32, plans.code_rom32.data(), code);
+      split(hn::PromoteTo(d, hn::LowerHalf(di32h, full)), s);
+      split(hn::PromoteTo(d, hn::UpperHalf(di32h, full)), s + lanes);
+    }
+  }
+  for (; s + lanes <= n; s += lanes) {
+    const auto code = hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(d32, hn::LoadU(d16, codes + s))));
+    split(hn::GatherIndex(d, code_rom, code), s);
   }
 #endif
   for (; s < n; ++s) {
@@ -550,6 +584,16 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     return hn::BitCast(d, hn::ShiftRightSame(hn::Add(sum, luma_half), p.luma_shift));  // uQ1.F
   };
   const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero), hn::Gt(v, one)); };
+  // exp(-i) of i in [0, 15]: where a vector holds 8 words (AVX-512), the 16-word ROM is two vectors, read by lane
+  // permutations (no gather); else gathered.
+  const auto rom_low = hn::LoadU(d, p.exp_integer.data());
+  const auto rom_high = lanes == 8 ? hn::LoadU(d, p.exp_integer.data() + lanes) : zero;
+  const auto lane_mask = hn::Set(d, static_cast<std::int64_t>(lanes) - 1);
+  const auto exp_of_integer = [&](const auto i) {
+    if (lanes != 8) return hn::GatherIndex(d, p.exp_integer.data(), i);
+    const auto lane = hn::IndicesFromVec(d, hn::And(i, lane_mask));
+    return hn::IfThenElse(hn::Gt(i, lane_mask), hn::TableLookupLanes(rom_high, lane), hn::TableLookupLanes(rom_low, lane));
+  };
   auto weight_sum = zero;
   for (; x + lanes <= pixels; x += lanes) {
     hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
@@ -587,7 +631,7 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, p.exp_input_frac_bits));
     const auto underflow = hn::AndNot(still, hn::Gt(integer, fifteen));
     const auto e_fraction = interpolate(p.exp_fraction, hn::And(exponent, fraction_mask));
-    const auto e_integer = hn::GatherIndex(d, p.exp_integer.data(), hn::Min(integer, fifteen));
+    const auto e_integer = exp_of_integer(hn::Min(integer, fifteen));
     const auto w = hn::BitCast(d, hn::ShiftRightSame(hn::Add(hn::MulEven(hn::BitCast(du32, e_integer),
                                                                          hn::BitCast(du32, e_fraction)), linear_half),
                                                      p.linear_frac_bits));
@@ -624,8 +668,15 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
   auto magnitude_max = zero;
   std::size_t phase = 0;
   const std::size_t phase_step = lanes % 3;
+  // Sample s + i of a vector reads pixel s / 3 + third[phase + i] (phase = s mod 3), all within the vector's first
+  // lanes / 3 + 1 pixels: one load of the pixels from s / 3 and a lane permutation, where that load stays within the
+  // n / 3 weights; else a gather.
+  const std::size_t pixels = n / 3;
   for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
-    const auto w = hn::GatherIndex(d, weight + s / 3, hn::LoadU(d, third.data() + phase));
+    const auto pixel = hn::LoadU(d, third.data() + phase);
+    const auto w = s / 3 + lanes <= pixels
+                       ? hn::TableLookupLanes(hn::LoadU(d, weight + s / 3), hn::IndicesFromVec(d, pixel))
+                       : hn::GatherIndex(d, weight + s / 3, pixel);
     if (!hn::AllFalse(d, hn::Or(hn::Lt(w, zero), hn::Gt(w, one)))) {
       for (std::size_t i = 0; i < lanes; ++i) {
         shown[s + i] = weighted_scalar(alpha[s + i], weight[(s + i) / 3], residual[s + i], kernels, tally);
@@ -773,6 +824,9 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   FixedLinePlans plans;
   if (!c.line_kernels) return plans;
   plans.code_rom = kernels.code_rom();
+  if (std::ranges::all_of(plans.code_rom, [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; })) {
+    plans.code_rom32.assign(plans.code_rom.begin(), plans.code_rom.end());
+  }
   plans.one = kernels.one();
   const int F = c.linear_frac_bits;
   const int W = c.bilinear_weight_frac_bits;
@@ -861,6 +915,44 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   return plans;
 }
 
+namespace {
+
+// DrivePlan::packed32 for a plan whose 32-bit tables are built, where every channel needs at most one step.
+void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, DrivePlan& d) {
+  const int m = d.mantissa_bits;
+  const int value_bits = channels[0]->value_bits();
+  const int offset_bits = value_bits - m;  // a bucket is at most 2^(value_bits - 1 - m) wide
+  int code_bits = 0;
+  for (const ThresholdIndex* index : channels) {
+    if (index->steps() != 1) return;
+    code_bits = std::max(code_bits, static_cast<int>(std::bit_width(index->padded().size())));
+  }
+  if (offset_bits < 1 || offset_bits + code_bits > 32) return;
+  std::vector<std::uint32_t> packed;
+  packed.reserve(d.base32.size());
+  for (const ThresholdIndex* index : channels) {
+    const std::vector<std::int64_t>& padded = index->padded();
+    for (std::size_t b = 0; b < index->base().size(); ++b) {
+      std::int64_t lo = static_cast<std::int64_t>(b);
+      std::int64_t width = 1;
+      if (b >= (std::size_t{1} << m)) {
+        const int lead = static_cast<int>(b >> m) + m - 1;
+        lo = ((std::int64_t{1} << m) + static_cast<std::int64_t>(b & ((std::size_t{1} << m) - 1))) << (lead - m);
+        width = std::int64_t{1} << (lead - m);
+      }
+      const std::uint16_t k = index->base()[b];
+      const std::int64_t next = padded[std::size_t{k} + 1];  // above lo (k is lo's code); the padding is INT64_MAX
+      if (next <= lo) return;
+      const std::int64_t offset = next - lo < width ? next - lo : width;
+      packed.push_back((std::uint32_t{k} << offset_bits) | static_cast<std::uint32_t>(offset));
+    }
+  }
+  d.packed32 = std::move(packed);
+  d.offset_bits = offset_bits;
+}
+
+}  // namespace
+
 std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& channels) {
   DrivePlan d;
   d.mantissa_bits = ThresholdIndex::kMantissaBits;
@@ -894,6 +986,7 @@ std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& 
       std::ranges::transform(d.thresholds, std::back_inserter(d.thresholds32), narrow);
       std::ranges::transform(d.bucket_offset, std::back_inserter(d.bucket_offset32), narrow);
       std::ranges::transform(d.threshold_offset, std::back_inserter(d.threshold_offset32), narrow);
+      packed_drive_search(channels, d);
     }
     return d;
   }
@@ -1020,8 +1113,8 @@ void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& pla
   HWY_DYNAMIC_DISPATCH(DriveCodes)(linear, n, plan, out);
 }
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
-                         const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho) {
-  return HWY_DYNAMIC_DISPATCH(Compensate)(codes, low, n, code_rom, one, shown, rho);
+                         const FixedLinePlans& plans, std::int64_t* shown, std::int64_t* rho) {
+  return HWY_DYNAMIC_DISPATCH(Compensate)(codes, low, n, plans, shown, rho);
 }
 void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
                       std::int64_t* out) {

@@ -75,6 +75,13 @@ struct DrivePlan {
   std::vector<std::int32_t> thresholds32;
   std::vector<std::int32_t> bucket_offset32;
   std::vector<std::int32_t> threshold_offset32;
+  // Where no bucket of any channel holds more than one threshold (steps == 1: 8-bit output at the default formats),
+  // the search is one gather: per bucket (at base32's positions), the channel's code at the bucket's lower end lo,
+  // shifted left by offset_bits, above the offset T_{k+1} - lo of the next threshold where it lies in the bucket, else
+  // the bucket's width, which no offset within the bucket reaches. The code is k, plus one where x - lo reaches the
+  // offset. Empty otherwise.
+  std::vector<std::uint32_t> packed32;
+  int offset_bits = 0;
 };
 
 // D's horizontal half over a line (FixedKernels::gaussian_horizontal_line, encoded space), one entry per reduced
@@ -173,6 +180,7 @@ struct FixedLinePlans {
   std::optional<GaussianPlan> gaussian;  // encoded space, max_code 2^T and max_code 2^L below 2^32
   std::optional<LcdPlan> lcd;            // LCD with the merge table (output codes up to 8 bits), F <= 30
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
+  std::vector<std::int32_t> code_rom32;  // the same where every word fits 32 bits (twice the lanes per gather)
   std::int64_t one = 0;
 
   static FixedLinePlans build(const FixedKernels& kernels);
@@ -195,10 +203,11 @@ void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std:
                      const EotfPlan& plan, std::int64_t* out);
 // out[s] = the drive code of linear[s] (channel s mod 3), as ThresholdIndex::search gives it.
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
-// Eq. 2 and the split (FixedKernels::compensate): beta = 2 lin(codes[s]) - low[s], shown[s] = clamp(beta, 0, one),
+// Eq. 2 and the split (FixedKernels::compensate): beta = 2 lin(codes[s]) - low[s] (lin through plans.code_rom),
+// shown[s] = clamp(beta, 0, one),
 // rho[s] = beta - shown[s]. Returns the number of clipped samples (beta outside [0, one]).
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
-                         const std::int64_t* code_rom, std::int64_t one, std::int64_t* shown, std::int64_t* rho);
+                         const FixedLinePlans& plans, std::int64_t* shown, std::int64_t* rho);
 // D's horizontal half: out[s] = round(sum_t weight[t n + s] row[index[t n + s]], T - L), half to even, for s < n.
 void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan,
                       int shift, std::int64_t* out);

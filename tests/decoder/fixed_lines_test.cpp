@@ -360,77 +360,112 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
 // FixedKernels::drive_code, value by value: every channel's thresholds and their neighbours, both sides of 2^24 (where
 // the 32-bit lanes' float conversion changes form), every octave, random values, and values outside [0, 1] (the
 // generic search), on every instruction set.
+// Both output depths: at 10 bits the index needs up to three steps (the two-gather search); at 8 bits one, which
+// takes the packed single gather (DrivePlan::packed32), and the two-gather search of the same tables beside it.
 TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
-  const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive", 10);
-  const fixed_detail::FixedKernels kernels(config);
-  ASSERT_TRUE(kernels.line_plans().drive.has_value());
-  const fixed_detail::DrivePlan& narrow = *kernels.line_plans().drive;
-  fixed_detail::DrivePlan wide_tables = narrow;
-  ASSERT_FALSE(narrow.base32.empty()) << "the default formats take the 32-bit lanes";
-  wide_tables.base32.clear();
-  const fixed_detail::DrivePlan& wide = wide_tables;
-  const std::int64_t one = kernels.one();
-  std::vector<std::int64_t> values;
-  // Sample s is read as channel s mod 3: each channel's thresholds go to its own samples.
-  for (int ch = 0; ch < 3; ++ch) {
-    for (const std::int64_t t : kernels.drive_index(ch).padded()) {
-      if (t > one + 1) continue;  // the padding past the last threshold (up to INT64_MAX) has no value in [0, 1]
-      for (const std::int64_t v : {t - 1, t, t + 1}) {
-        if (v < 0 || v > one) continue;
-        while (values.size() % 3 != static_cast<std::size_t>(ch)) values.push_back(one / 2);
-        values.push_back(v);
+  for (const int output_bits : {10, 8}) {
+    const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive", output_bits);
+    const fixed_detail::FixedKernels kernels(config);
+    ASSERT_TRUE(kernels.line_plans().drive.has_value());
+    const fixed_detail::DrivePlan& narrow = *kernels.line_plans().drive;
+    ASSERT_FALSE(narrow.base32.empty()) << "the default formats take the 32-bit lanes";
+    ASSERT_EQ(narrow.packed32.empty(), output_bits == 10) << output_bits << "-bit output";
+    fixed_detail::DrivePlan unpacked_tables = narrow;
+    unpacked_tables.packed32.clear();
+    fixed_detail::DrivePlan wide_tables = unpacked_tables;
+    wide_tables.base32.clear();
+    const fixed_detail::DrivePlan& unpacked = unpacked_tables;
+    const fixed_detail::DrivePlan& wide = wide_tables;
+    const std::int64_t one = kernels.one();
+    std::vector<std::int64_t> values;
+    // Sample s is read as channel s mod 3: each channel's thresholds go to its own samples.
+    for (int ch = 0; ch < 3; ++ch) {
+      for (const std::int64_t t : kernels.drive_index(ch).padded()) {
+        if (t > one + 1) continue;  // the padding past the last threshold (up to INT64_MAX) has no value in [0, 1]
+        for (const std::int64_t v : {t - 1, t, t + 1}) {
+          if (v < 0 || v > one) continue;
+          while (values.size() % 3 != static_cast<std::size_t>(ch)) values.push_back(one / 2);
+          values.push_back(v);
+        }
+      }
+    }
+    for (int bit = 0; bit <= config.linear_frac_bits; ++bit) {
+      for (const std::int64_t v : {(std::int64_t{1} << bit) - 1, std::int64_t{1} << bit, (std::int64_t{1} << bit) + 31}) {
+        if (v >= 0 && v <= one) values.push_back(v);
+      }
+    }
+    std::mt19937_64 random(29);
+    std::uniform_int_distribution<std::int64_t> linear(0, one);
+    for (int i = 0; i < 20000; ++i) values.push_back(linear(random));
+    values.push_back(-1);
+    values.push_back(one + 1);
+    values.push_back(std::int64_t{1} << 40);
+    std::vector<std::uint16_t> expected(values.size());
+    for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_code(values[s], static_cast<int>(s % 3));
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      for (const fixed_detail::DrivePlan* plan : {&narrow, &unpacked, &wide}) {
+        std::vector<std::uint16_t> codes(values.size());
+        fixed_detail::lines::drive_codes(values.data(), values.size(), *plan, codes.data());
+        for (std::size_t s = 0; s < values.size(); ++s) {
+          ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << " " << output_bits << "-bit output, "
+                                           << (plan == &wide ? "64-bit" : plan == &unpacked ? "32-bit" : "packed")
+                                           << " sample " << s << " value " << values[s];
+        }
       }
     }
   }
-  for (int bit = 0; bit <= config.linear_frac_bits; ++bit) {
-    for (const std::int64_t v : {(std::int64_t{1} << bit) - 1, std::int64_t{1} << bit, (std::int64_t{1} << bit) + 31}) {
-      if (v >= 0 && v <= one) values.push_back(v);
-    }
-  }
-  std::mt19937_64 random(29);
-  std::uniform_int_distribution<std::int64_t> linear(0, one);
-  for (int i = 0; i < 20000; ++i) values.push_back(linear(random));
-  values.push_back(-1);
-  values.push_back(one + 1);
-  values.push_back(std::int64_t{1} << 40);
-  std::vector<std::uint16_t> expected(values.size());
-  for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_code(values[s], static_cast<int>(s % 3));
-  // A ROM with thresholds at 2^k - 1, 2^k and at the second bucket of each octave, 2^k + 2^(k-7), for every k up to
-  // the index's 2^30: the last value of an octave and of its first bucket each have a code of their own, which a float
-  // conversion that rounded a run of ones up into the next bucket would miss (below 2^30 the shifted value must stay
-  // under 2^24).
-  std::vector<std::int64_t> octave_ends{0};
+}
+
+// ROMs with thresholds where a float conversion or a bucket's bounds could go wrong, up to the index's 2^30, through
+// the two-gather search and the packed single gather:
+//   * ends: at 2^k - 1, 2^k and the second bucket of each octave, 2^k + 2^(k-7): the last value of an octave and of
+//     its first bucket each have a code of their own, which a float conversion that rounded a run of ones up into the
+//     next bucket would miss (below 2^30 the shifted value must stay under 2^24); thresholds on bucket starts;
+//   * inside: at 2^k + 1 and at the last value of the second bucket, 2^k + 2^(k-6) - 1 (one threshold per bucket, at
+//     the smallest and the largest offset within it).
+TEST(FixedLines, OledDriveKernelAtOctaveAndBucketEnds) {
+  std::vector<std::int64_t> ends{0};
+  std::vector<std::int64_t> inside{0};
   for (int k = 1; k < 30; ++k) {
-    if ((std::int64_t{1} << k) - 1 > octave_ends.back()) octave_ends.push_back((std::int64_t{1} << k) - 1);
-    octave_ends.push_back(std::int64_t{1} << k);
-    if (k >= 8) octave_ends.push_back((std::int64_t{1} << k) + (std::int64_t{1} << (k - 7)));
-  }
-  const fixed_detail::ThresholdIndex ends(octave_ends, 30);
-  const std::optional<fixed_detail::DrivePlan> ends_plan = fixed_detail::drive_plan({&ends, &ends, &ends});
-  ASSERT_TRUE(ends_plan.has_value() && !ends_plan->base32.empty());
-  std::vector<std::int64_t> end_values;
-  for (const std::int64_t t : octave_ends) {
-    for (const std::int64_t v : {t - 2, t - 1, t, t + 1}) end_values.push_back(v);
-  }
-  for (const std::int64_t v : {(std::int64_t{1} << 30) - 1, (std::int64_t{1} << 30) - 32, std::int64_t{541065215}}) {
-    end_values.push_back(v);  // the top of the index, and 2^29 + 2^22 - 1 (bits 0-21 set)
-  }
-  std::vector<std::uint16_t> end_expected(end_values.size());
-  for (std::size_t s = 0; s < end_values.size(); ++s) end_expected[s] = ends.search(end_values[s]);
-  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    const TargetMock mock(target);
-    for (const fixed_detail::DrivePlan* plan : {&narrow, &wide}) {
-      std::vector<std::uint16_t> codes(values.size());
-      fixed_detail::lines::drive_codes(values.data(), values.size(), *plan, codes.data());
-      for (std::size_t s = 0; s < values.size(); ++s) {
-        ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << (plan == &wide ? " 64-bit" : " 32-bit")
-                                         << " sample " << s << " value " << values[s];
-      }
+    if ((std::int64_t{1} << k) - 1 > ends.back()) ends.push_back((std::int64_t{1} << k) - 1);
+    ends.push_back(std::int64_t{1} << k);
+    if (k >= 8) ends.push_back((std::int64_t{1} << k) + (std::int64_t{1} << (k - 7)));
+    if (k < 8) {
+      if ((std::int64_t{1} << k) - 1 > inside.back()) inside.push_back((std::int64_t{1} << k) - 1);
+      inside.push_back(std::int64_t{1} << k);
+    } else {
+      inside.push_back((std::int64_t{1} << k) + 1);
+      inside.push_back((std::int64_t{1} << k) + (std::int64_t{1} << (k - 6)) - 1);
     }
-    std::vector<std::uint16_t> codes(end_values.size());
-    fixed_detail::lines::drive_codes(end_values.data(), end_values.size(), *ends_plan, codes.data());
-    for (std::size_t s = 0; s < end_values.size(); ++s) {
-      ASSERT_EQ(codes[s], end_expected[s]) << hwy::TargetName(target) << " octave ends, value " << end_values[s];
+  }
+  for (const std::vector<std::int64_t>* thresholds : {&ends, &inside}) {
+    const char* name = thresholds == &ends ? "octave ends" : "inside buckets";
+    const fixed_detail::ThresholdIndex index(*thresholds, 30);
+    const std::optional<fixed_detail::DrivePlan> plan = fixed_detail::drive_plan({&index, &index, &index});
+    ASSERT_TRUE(plan.has_value() && !plan->base32.empty()) << name;
+    ASSERT_FALSE(plan->packed32.empty()) << name << ": one step per bucket";
+    fixed_detail::DrivePlan unpacked = *plan;
+    unpacked.packed32.clear();
+    std::vector<std::int64_t> values;
+    for (const std::int64_t t : *thresholds) {
+      for (const std::int64_t v : {t - 2, t - 1, t, t + 1}) values.push_back(v);
+    }
+    for (const std::int64_t v : {(std::int64_t{1} << 30) - 1, (std::int64_t{1} << 30) - 32, std::int64_t{541065215}}) {
+      values.push_back(v);  // the top of the index, and 2^29 + 2^22 - 1 (bits 0-21 set)
+    }
+    std::vector<std::uint16_t> expected(values.size());
+    for (std::size_t s = 0; s < values.size(); ++s) expected[s] = index.search(values[s]);
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      for (const fixed_detail::DrivePlan* p : {&plan.value(), static_cast<const fixed_detail::DrivePlan*>(&unpacked)}) {
+        std::vector<std::uint16_t> codes(values.size());
+        fixed_detail::lines::drive_codes(values.data(), values.size(), *p, codes.data());
+        for (std::size_t s = 0; s < values.size(); ++s) {
+          ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << " " << name
+                                           << (p == &unpacked ? " two gathers" : " packed") << ", value " << values[s];
+        }
+      }
     }
   }
 }
