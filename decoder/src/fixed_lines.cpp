@@ -326,11 +326,6 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
   const hn::Repartition<std::int64_t, decltype(du)> d64;
   const hn::RebindToUnsigned<decltype(d64)> du64;
   const std::size_t lanes = hn::Lanes(du);
-  thread_local std::vector<std::uint32_t> wide;
-  wide.resize(row_samples + lanes);
-  std::size_t i = 0;
-  for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
-  for (; i < row_samples; ++i) wide[i] = row[i];
   const auto one = hn::Set(du, 1u);
   const auto rest_mask = hn::Set(du, (std::uint32_t{1} << (shift - 1)) - 1u);
   const auto zero = hn::Zero(du);
@@ -350,11 +345,51 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
     thread_local std::vector<std::uint32_t> planes;
     const std::size_t plane_samples = plan.plane_source.size();
     planes.resize(plane_samples + lanes);
-    std::size_t p = 0;
-    for (; p + lanes <= plane_samples; p += lanes) {
-      hn::StoreU(hn::GatherIndex(du, wide.data(), hn::LoadU(di, plan.plane_source.data() + p)), du, planes.data() + p);
+    // The planes from the row's channels over the columns c + j, j < f M (clamped at the row's ends): the row
+    // deinterleaved into channels where the columns lie inside it, then each channel split into its f phases (at
+    // f = 2 by even and odd lanes). The same samples as plane_source names.
+    const std::size_t span = f * length;
+    thread_local std::vector<std::uint32_t> channel_rows;
+    channel_rows.resize(3 * span + lanes);
+    std::uint32_t* channel[3] = {channel_rows.data(), channel_rows.data() + span, channel_rows.data() + 2 * span};
+    const auto width = static_cast<std::int64_t>(plan.full_width);
+    const std::int64_t c0 = plan.first_column;
+    const auto inside_begin = static_cast<std::size_t>(std::clamp<std::int64_t>(-c0, 0, static_cast<std::int64_t>(span)));
+    const auto inside_end = static_cast<std::size_t>(
+        std::clamp<std::int64_t>(width - c0, static_cast<std::int64_t>(inside_begin), static_cast<std::int64_t>(span)));
+    const auto clamped_column = [&](std::size_t j) {
+      return static_cast<std::size_t>(std::clamp<std::int64_t>(c0 + static_cast<std::int64_t>(j), 0, width - 1));
+    };
+    std::size_t j = 0;
+    for (; j < inside_begin; ++j) {
+      for (std::size_t ch = 0; ch < 3; ++ch) channel[ch][j] = row[3 * clamped_column(j) + ch];
     }
-    for (; p < plane_samples; ++p) planes[p] = wide[static_cast<std::size_t>(plan.plane_source[p])];
+    for (; j + lanes <= inside_end; j += lanes) {
+      hn::Vec<decltype(d16)> r, g, b;
+      hn::LoadInterleaved3(d16, row + 3 * static_cast<std::size_t>(c0 + static_cast<std::int64_t>(j)), r, g, b);
+      hn::StoreU(hn::PromoteTo(du, r), du, channel[0] + j);
+      hn::StoreU(hn::PromoteTo(du, g), du, channel[1] + j);
+      hn::StoreU(hn::PromoteTo(du, b), du, channel[2] + j);
+    }
+    for (; j < span; ++j) {
+      for (std::size_t ch = 0; ch < 3; ++ch) channel[ch][j] = row[3 * clamped_column(j) + ch];
+    }
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      std::uint32_t* even = planes.data() + ch * f * length;
+      std::size_t m = 0;
+      if (f == 2) {
+        std::uint32_t* odd = even + length;
+        for (; m + lanes <= length; m += lanes) {
+          const auto low = hn::LoadU(du, channel[ch] + 2 * m);
+          const auto high = hn::LoadU(du, channel[ch] + 2 * m + lanes);
+          hn::StoreU(hn::ConcatEven(du, high, low), du, even + m);
+          hn::StoreU(hn::ConcatOdd(du, high, low), du, odd + m);
+        }
+      }
+      for (; m < length; ++m) {
+        for (std::size_t p = 0; p < f; ++p) even[p * length + m] = channel[ch][f * m + p];
+      }
+    }
     const std::uint32_t* red = planes.data();
     const std::uint32_t* green = red + f * length;
     const std::uint32_t* blue = green + f * length;
@@ -379,6 +414,12 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
     }
     s = 3 * k;
   } else {
+    // The row's samples widened once, so the taps are 32-bit gathers.
+    thread_local std::vector<std::uint32_t> wide;
+    wide.resize(row_samples + lanes);
+    std::size_t i = 0;
+    for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
+    for (; i < row_samples; ++i) wide[i] = row[i];
     for (; s + lanes <= n; s += lanes) {
       auto acc = zero;
       for (std::size_t t = 0; t < plan.taps; ++t) {
@@ -1065,6 +1106,8 @@ GaussianColumnsPlan gaussian_columns_plan(const Geometry& g) {
     }
   }
   plan.decimation = f;
+  plan.first_column = start;
+  plan.full_width = full_width;
   plan.columns = columns;
   plan.plane_length = columns + (plan.taps - 1) / f;
   plan.plane_source.resize(3 * f * plan.plane_length);

@@ -103,6 +103,8 @@ struct GaussianColumnsPlan {
   std::size_t columns = 0;             // reduced width K
   std::size_t plane_length = 0;        // M = K + (taps - 1) div f
   std::vector<std::int32_t> plane_source;     // [(ch f + p) M + m]: the row sample of plane (ch, p) at m
+  std::int64_t first_column = 0;  // c: plane (ch, p) at m holds column clamp(c + f m + p) of the row's full_width
+  std::size_t full_width = 0;
   std::vector<std::uint32_t> planar_weight;   // [t K + k]: tap slot t's weight of column k (every channel's)
 };
 
