@@ -3,9 +3,14 @@
 #include "fixed_core.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace trm::fixed_detail {
 
@@ -33,11 +38,24 @@ bool unshared(const cv::Mat& m) { return m.u != nullptr && m.u->refcount == 1; }
 
 }  // namespace
 
+cv::Mat frame_plane(cv::Size size, int type) {
+  cv::Mat plane(size, type);
+#if defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(plane.data);
+  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t last = (begin + plane.total() * plane.elemSize()) & ~(kHugePage - 1);
+  // Advice only: where the kernel declines it, the plane keeps its 4 KiB pages.
+  if (last > first) (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+#endif
+  return plane;
+}
+
 cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type) {
   for (const cv::Mat& spare : spares) {
     if (spare.size() == size && spare.type() == type && unshared(spare)) return spare;
   }
-  cv::Mat plane(size, type);
+  cv::Mat plane = frame_plane(size, type);
   spares.push_back(plane);
   return plane;
 }
@@ -61,11 +79,11 @@ FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye)
       return out;
     }
   }
-  out.frame.drive_codes.create(full, CV_16UC3);
+  out.frame.drive_codes = frame_plane(full, CV_16UC3);
   if (planes) {
-    out.frame.wanted_linear.create(full, CV_64FC3);
-    out.frame.drive.create(full, CV_64FC3);
-    out.frame.emitted_linear.create(full, CV_64FC3);
+    out.frame.wanted_linear = frame_plane(full, CV_64FC3);
+    out.frame.drive = frame_plane(full, CV_64FC3);
+    out.frame.emitted_linear = frame_plane(full, CV_64FC3);
   }
   // Two in flight (the one returned and the held output) and one being filled cover a caller that keeps one view.
   constexpr std::size_t kSpareOutputs = 3;
@@ -83,8 +101,10 @@ void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
   out.lcd_held = eye.lcd_previous_drive.empty();
   if (out.lcd_held) {
     // Not read on the held frame (lcd_drive takes x_{t-1} = x_t and the held code); zeroed to stay defined.
-    eye.lcd_previous_drive = cv::Mat::zeros(eye.full_size, CV_16UC3);
-    eye.lcd_previous_linear = cv::Mat::zeros(eye.full_size, CV_32SC3);
+    eye.lcd_previous_drive = frame_plane(eye.full_size, CV_16UC3);
+    eye.lcd_previous_linear = frame_plane(eye.full_size, CV_32SC3);
+    eye.lcd_previous_drive.setTo(0);
+    eye.lcd_previous_linear.setTo(0);
   }
 }
 

@@ -65,7 +65,11 @@ struct EyeState {
   std::vector<cv::Mat> spare_planes;
 };
 
-// A plane of `size` and `type` from `spares` that nothing else holds, else a new one (kept in `spares` for later).
+// A new frame-sized plane whose whole 2 MiB spans are advised to the kernel for transparent huge pages (Linux
+// MADV_HUGEPAGE, which Debian's default "madvise" mode needs): its first touch then faults a few 2 MiB pages instead of
+// one 4 KiB page at a time, which a fresh decoder's first views otherwise pay (docs/performance_history.md).
+cv::Mat frame_plane(cv::Size size, int type);
+// A plane of `size` and `type` from `spares` that nothing else holds, else a new frame_plane (kept in `spares`).
 cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type);
 
 // The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator

@@ -63,10 +63,9 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
   if (frame.codes.size() != expected) {
     throw std::invalid_argument(what + "codes are " + codes_size + expected_size_text(meta, link, expected));
   }
-  double highest = 0.0;
-  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
+  const int highest = highest_code(frame.codes);
   if (highest > (1 << link.bits) - 1) {
-    throw std::invalid_argument(what + "code " + std::to_string(static_cast<int>(highest)) + " exceeds the " +
+    throw std::invalid_argument(what + "code " + std::to_string(highest) + " exceeds the " +
                                 std::to_string(link.bits) + "-bit range");
   }
 }

@@ -2,10 +2,25 @@
 
 #include "exact_text.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 namespace trm {
+
+std::uint16_t highest_code(const cv::Mat& codes) {
+  if (codes.empty()) return 0;
+  if (codes.depth() != CV_16U) throw std::invalid_argument("highest_code: codes must be CV_16U");
+  const auto samples = static_cast<std::size_t>(codes.cols) * static_cast<std::size_t>(codes.channels());
+  std::uint16_t highest = 0;
+  for (int y = 0; y < codes.rows; ++y) {
+    const auto* row = codes.ptr<std::uint16_t>(y);
+    std::uint16_t row_highest = 0;
+    for (std::size_t i = 0; i < samples; ++i) row_highest = std::max(row_highest, row[i]);
+    highest = std::max(highest, row_highest);
+  }
+  return highest;
+}
 
 void check_view_meta(const FrameMeta& meta, const std::string& what) {
   if (meta.index < 0) throw std::invalid_argument(what + "frame index must be >= 0");

@@ -18,10 +18,9 @@ std::vector<std::uint8_t> jpegls_encode(const cv::Mat& codes, int bits) {
   check_bits(bits);
   if (codes.type() != CV_16UC3 || codes.empty() || codes.cols > 0xFFFF || codes.rows > 0xFFFF)
     throw std::invalid_argument("JPEG-LS: expected non-empty CV_16UC3 codes of at most 65535 x 65535");
-  double max_code = 0.0;
-  cv::minMaxLoc(codes.reshape(1), nullptr, &max_code);
-  if (max_code >= static_cast<double>(1 << bits))
-    throw std::invalid_argument("JPEG-LS: code " + std::to_string(static_cast<int>(max_code)) + " does not fit " +
+  const int max_code = highest_code(codes);
+  if (max_code >= (1 << bits))
+    throw std::invalid_argument("JPEG-LS: code " + std::to_string(max_code) + " does not fit " +
                                 std::to_string(bits) + " bits");
 
   // CharLS takes samples of up to 8 bits as bytes and of 9-16 bits as native 16-bit words.
@@ -83,9 +82,7 @@ cv::Mat jpegls_decode(std::span<const std::uint8_t> data, int width, int height,
       return wide;
     }
     // 10-bit samples arrive in 16-bit words; CharLS masks them to 10 bits, but check rather than assume.
-    double max_code = 0.0;
-    cv::minMaxLoc(decoded.reshape(1), nullptr, &max_code);
-    if (max_code >= 1024.0) throw JpegLsError("JPEG-LS decode: sample exceeds 10 bits");
+    if (highest_code(decoded) >= 1024) throw JpegLsError("JPEG-LS decode: sample exceeds 10 bits");
     return decoded;
   } catch (const JpegLsError&) {
     throw;

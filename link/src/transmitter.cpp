@@ -97,10 +97,9 @@ SentView Transmitter::send(const LinkFrame& view) {
   if (view.codes.type() != CV_16UC3 || view.codes.cols != m.width || view.codes.rows != m.height)
     throw std::invalid_argument("link transmitter: codes must be CV_16UC3 of " + std::to_string(m.width) + "x" +
                                 std::to_string(m.height) + " (the size in the frame's metadata)");
-  double max_code = 0.0;
-  cv::minMaxLoc(view.codes.reshape(1), nullptr, &max_code);
-  if (max_code >= static_cast<double>(1 << m.bits))
-    throw std::invalid_argument("link transmitter: code " + std::to_string(static_cast<int>(max_code)) +
+  const int max_code = highest_code(view.codes);
+  if (max_code >= (1 << m.bits))
+    throw std::invalid_argument("link transmitter: code " + std::to_string(max_code) +
                                 " does not fit " + std::to_string(m.bits) + " bits");
 
   SentView sent;

@@ -181,6 +181,37 @@ TEST(TrmEncoder, RejectsInvalidFrames) {
 }  // namespace trm
 
 // One writer and one reader of the encoder configuration (capture headers, reports).
+// highest_code against cv::minMaxLoc (the check it replaces): random codes of every width, 1 and 3 channels, the
+// largest code anywhere in a row (first, last, a row's middle), a region of a larger image (rows not contiguous, the
+// region's neighbours higher than anything inside it), empty; another depth is refused.
+TEST(HighestCode, AgreesWithMinMaxLocAndReadsOnlyTheImage) {
+  cv::RNG random(11);
+  for (const int channels : {1, 3}) {
+    for (const int width : {1, 2, 7, 33, 2160}) {
+      cv::Mat codes(5, width, CV_16UC(channels));
+      random.fill(codes, cv::RNG::UNIFORM, 0, 1000);
+      for (const int at : {0, width * channels - 1, (width * channels) / 2}) {
+        cv::Mat probe = codes.clone();
+        probe.ptr<std::uint16_t>(3)[at] = 1023;
+        double expected = 0.0;
+        cv::minMaxLoc(probe.reshape(1), nullptr, &expected);
+        EXPECT_EQ(trm::highest_code(probe), static_cast<int>(expected)) << channels << " channels, width " << width;
+      }
+      double expected = 0.0;
+      cv::minMaxLoc(codes.reshape(1), nullptr, &expected);
+      EXPECT_EQ(trm::highest_code(codes), static_cast<int>(expected));
+    }
+  }
+  cv::Mat larger(40, 50, CV_16UC3, cv::Scalar::all(900));
+  cv::Mat region = larger(cv::Rect(5, 6, 20, 10));
+  region.setTo(cv::Scalar::all(17));
+  region.at<cv::Vec3w>(9, 19)[2] = 300;
+  ASSERT_FALSE(region.isContinuous());
+  EXPECT_EQ(trm::highest_code(region), 300);
+  EXPECT_EQ(trm::highest_code(cv::Mat()), 0);
+  EXPECT_THROW(trm::highest_code(cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(1))), std::invalid_argument);
+}
+
 TEST(EncoderJson, RoundTripsAndRefusesWhatTheCommandLineWouldRefuse) {
   trm::EncoderConfig config;
   config.reduction = 0.25;

@@ -49,7 +49,7 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
       const std::string name = d["name"].get<std::string>();
       names.insert(name);
       for (const char* field : {"threads", "mpix_per_s", "ms_per_frame", "ratio_to_opencv", "peak_rss_mib",
-                                "rss_before_mib"}) {
+                                "rss_before_mib", "first_pair_ms"}) {
         expect_positive(d[field], name + " " + field);
       }
       // The working memory is the peak less the resident set before: within [0, peak], and its ratio to the
@@ -63,6 +63,8 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
       for (const char* hz : {"90", "120", "144"}) expect_positive(d["realtime_factor"][hz], name + " RT " + hz);
       ASSERT_EQ(d["repeat_seconds"].size(), 2u) << name;
       for (const nlohmann::json& s : d["repeat_seconds"]) expect_positive(s, name + " repeat");
+      ASSERT_EQ(d["repeat_first_pair_seconds"].size(), 2u) << name;
+      for (const nlohmann::json& s : d["repeat_first_pair_seconds"]) expect_positive(s, name + " first pair");
     }
     EXPECT_EQ(names, (std::set<std::string>{"fixed", "fixed-1t", "fixed+planes", "fixed-frame", "reference",
                                               "opencv-float32"}));

@@ -101,10 +101,9 @@ void check_received(const LinkFrame& frame, const DecoderConfig& config, const c
     throw std::invalid_argument(where + "codes must be CV_16UC3 of " + std::to_string(meta.width) + "x" +
                                 std::to_string(meta.height));
   }
-  double highest = 0.0;
-  cv::minMaxLoc(frame.codes.reshape(1), nullptr, &highest);
+  const int highest = highest_code(frame.codes);
   if (highest > std::ldexp(1.0, meta.bits) - 1.0) {
-    throw std::invalid_argument(where + "code " + std::to_string(static_cast<int>(highest)) + " exceeds " +
+    throw std::invalid_argument(where + "code " + std::to_string(highest) + " exceeds " +
                                 std::to_string(meta.bits) + " bits");
   }
 }

@@ -61,4 +61,9 @@ struct LinkFrame {
   cv::Mat codes;
 };
 
+// The largest code of a CV_16U image of any channel count (0 if empty): the range check of every frame a decoder or
+// the link takes, in one pass over the rows that the compiler vectorises (cv::minMaxLoc also finds the smallest and
+// both locations, several times slower on a headset-size view). Throws std::invalid_argument on another depth.
+std::uint16_t highest_code(const cv::Mat& codes);
+
 }  // namespace trm
