@@ -5,6 +5,10 @@
 #include <exception>
 #include <iostream>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #ifndef TRM_VERSION
 #define TRM_VERSION "0.0.0"
 #endif
@@ -15,6 +19,15 @@ int run_main(int argc, char** argv) {
   // First, before any thread starts: every later thread inherits the blocked signals, so only the cleanup
   // thread receives them.
   io::install_signal_cleanup();
+#if defined(__GLIBC__)
+  // Frame-sized buffers stay in the process's heap once freed instead of going back to the kernel: glibc serves blocks
+  // of 32 MiB and more (a 2160x1200 double plane is 59 MiB) by mmap, unmaps them on free and trims the heap's top, so
+  // every frame faulted its buffers in again page by page (about 10 us a page on a virtual machine; the OpenCV
+  // pipeline of `trm bench` ran at 4.3 Mpix/s so and at 36 without, docs/performance_history.md). The resident set
+  // stays at its peak; malloc_trim still gives the free pages back.
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_TRIM_THRESHOLD, -1);
+#endif
   CLI::App app{"trm: headset-side Temporal Resolution Multiplexing simulator "
                "(GPU-side encoder, simulated link, bit-accurate display-controller decoder, panel and eye models)"};
   app.set_version_flag("--version", std::string("trm ") + TRM_VERSION);
