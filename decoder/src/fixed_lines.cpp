@@ -461,6 +461,79 @@ void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, 
   }
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// The largest k with M(T_k, v_{t-1}) <= m, branch-free over the merge table's row at `row_offset` (its first word):
+// target_scaled = m scale, compared with the row's integers.
+template <class D>
+HWY_INLINE hn::Vec<D> LcdBinarySearch(D d, const LcdPlan& p, hn::Vec<D> target_scaled, hn::Vec<D> row_offset) {
+  const auto unit = hn::Set(d, std::int64_t{1});
+  auto lo = hn::Zero(d);
+  auto hi = hn::Set(d, std::int64_t{p.top});
+  for (int i = 0; i < p.steps; ++i) {
+    const auto active = hn::Lt(lo, hi);
+    const auto mid = hn::ShiftRight<1>(hn::Add(hn::Add(lo, hi), unit));
+    const auto merge = hn::GatherIndex(d, p.merge.data(), hn::Add(row_offset, hn::IfThenElse(active, mid, unit)));
+    const auto up = hn::And(active, hn::Not(hn::Lt(target_scaled, merge)));
+    const auto down = hn::AndNot(up, active);
+    lo = hn::IfThenElse(up, mid, lo);
+    hi = hn::IfThenElse(down, hn::Sub(mid, unit), hi);
+  }
+  return lo;
+}
+
+// The same code through LcdPlan::index (one gather): row is the row's number (v_{t-1}, or 2^o for the held row).
+template <class D>
+HWY_INLINE hn::Vec<D> LcdIndexSearch(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> row) {
+  const hn::RebindToUnsigned<D> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Rebind<std::int32_t, D> d32;
+  const auto t = hn::Min(hn::Max(target, hn::Zero(d)), hn::Set(d, p.one));
+  const auto q = hn::ShiftRightSame(t, p.index_shift);
+  const auto at = hn::Add(hn::BitCast(d, hn::MulEven(hn::BitCast(du32, row),
+                                                     hn::BitCast(du32, hn::Set(du, static_cast<std::uint64_t>(p.index_buckets))))),
+                          q);
+  const auto* words = reinterpret_cast<const std::int32_t*>(p.index.data());
+  const auto word = hn::PromoteTo(du, hn::BitCast(hn::RebindToUnsigned<decltype(d32)>(),
+                                                  hn::GatherIndex(d32, words, hn::BitCast(d32, hn::TruncateTo(hn::RebindToUnsigned<decltype(d32)>(), hn::BitCast(du, at))))));
+  const auto low = hn::BitCast(du, hn::Sub(t, hn::ShiftLeftSame(q, p.index_shift)));
+  const auto offset = hn::And(word, hn::Set(du, (std::uint64_t{1} << p.index_offset_bits) - 1));
+  const auto k = hn::ShiftRightSame(word, p.index_offset_bits);
+  return hn::BitCast(d, hn::Add(k, hn::IfThenZeroElse(hn::Lt(low, offset), hn::Set(du, std::uint64_t{1}))));
+}
+#endif
+
+void LcdSearch(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& p,
+               std::uint16_t* codes) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const auto scale = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.scale}));
+  for (; s + hn::Lanes(d) <= n; s += hn::Lanes(d)) {
+    const auto t = hn::LoadU(d, target + s);
+    const auto row = hn::LoadU(d, rows + s);
+    const auto code = p.index.empty()
+                          ? LcdBinarySearch(d, p, hn::BitCast(d, hn::MulEven(hn::BitCast(du32, t), scale)),
+                                            hn::ShiftLeftSame(row, p.width_log2))
+                          : LcdIndexSearch(d, p, t, row);
+    hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, code)), d16, codes + s);
+  }
+#endif
+  for (; s < n; ++s) {  // the binary search of FixedKernels::lcd_drive
+    const std::int64_t* row = p.merge.data() + rows[s] * p.width;
+    const std::int64_t scaled = target[s] * static_cast<std::int64_t>(p.scale);
+    int lo = 0;
+    int hi = p.top;
+    while (lo < hi) {
+      const int mid = (lo + hi + 1) / 2;
+      if (scaled >= row[mid]) lo = mid; else hi = mid - 1;
+    }
+    codes[s] = static_cast<std::uint16_t>(lo);
+  }
+}
+
 // One sample of the LCD drive by the stage function, with emit's frame-store update.
 inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const FixedKernels& kernels,
                                 std::uint16_t& previous_code, std::int32_t& previous_linear, bool held,
@@ -497,7 +570,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto top = hn::Set(d, std::int64_t{p.top});
   const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
   const auto exponent_bias = hn::Set(d, std::int64_t{1023});
-  const auto held_row = hn::Set(d, p.width << p.width_log2);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
+  const auto held_row = hn::Set(d, p.width);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
   for (; s + lanes <= n; s += lanes) {
     const auto x = hn::LoadU(d, wanted + s);
     // The eye's first frame takes the pixel as held at x_t (FixedKernels::lcd_drive): x_{t-1} = x_t, and v_{t-1} is
@@ -521,24 +594,15 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto rom_target = hn::Shr(hn::Add(exact, hn::Shl(unit, hn::Sub(scale_bits, unit))), scale_bits);
     const auto target = hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
     const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target), scale));
-    // The largest k with M(T_k, v_{t-1}) <= m, branch-free over the merge table's row.
+    // The largest k with M(T_k, v_{t-1}) <= m: through the per-row index, else the binary search of the row.
+    const bool indexed = !p.index.empty();
     const auto search = [&](const auto row) {
-      auto lo = zero;
-      auto hi = top;
-      for (int i = 0; i < p.steps; ++i) {
-        const auto active = hn::Lt(lo, hi);
-        const auto mid = hn::ShiftRight<1>(hn::Add(hn::Add(lo, hi), unit));
-        const auto merge = hn::GatherIndex(d, p.merge.data(), hn::Add(row, hn::IfThenElse(active, mid, unit)));
-        const auto up = hn::And(active, hn::Not(hn::Lt(target_scaled, merge)));
-        const auto down = hn::AndNot(up, active);
-        lo = hn::IfThenElse(up, mid, lo);
-        hi = hn::IfThenElse(down, hn::Sub(mid, unit), hi);
-      }
-      return lo;
+      return indexed ? LcdIndexSearch(d, p, target, row)
+                     : LcdBinarySearch(d, p, target_scaled, hn::ShiftLeftSame(row, p.width_log2));
     };
     const auto j = held ? search(held_row)
                         : hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d16, previous_code + s))));
-    const auto lo = search(hn::ShiftLeftSame(j, p.width_log2));
+    const auto lo = search(j);
     const auto end_dark = hn::GatherIndex(d, p.end_dark.data(), j);
     const auto end_bright = hn::GatherIndex(d, p.end_bright.data(), j);
     const auto below = hn::Lt(sum, hn::Add(end_dark, end_dark));
@@ -947,6 +1011,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
                       l.end_bright.size() == static_cast<std::size_t>(l.width);
     if (fits) {
       l.target_packed = std::move(*packed);
+      lcd_search_index(l);
       plans.lcd = std::move(l);
     }
   }
@@ -993,6 +1058,55 @@ void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, D
 }
 
 }  // namespace
+
+void lcd_search_index(LcdPlan& plan) {
+  plan.index.clear();
+  const std::int64_t rows = plan.width + 1;
+  const std::int64_t one = plan.one;
+  const auto scale = static_cast<std::int64_t>(plan.scale);
+  if (scale <= 0 || plan.top < 1 || plan.merge.size() < static_cast<std::size_t>(rows * plan.width)) return;
+  // Each row's thresholds in the target's units, increasing; every one in [1, one].
+  std::vector<std::int64_t> thresholds(static_cast<std::size_t>(rows * plan.top));
+  for (std::int64_t r = 0; r < rows; ++r) {
+    for (std::int64_t k = 1; k <= plan.top; ++k) {
+      const std::int64_t merge = plan.merge[static_cast<std::size_t>(r * plan.width + k)];
+      const std::int64_t u = merge <= 0 ? 0 : (merge + scale - 1) / scale;
+      if (u < 1 || u > one || (k > 1 && u < thresholds[static_cast<std::size_t>(r * plan.top + k - 2)])) return;
+      thresholds[static_cast<std::size_t>(r * plan.top + k - 1)] = u;
+    }
+  }
+  const int F = plan.linear_frac_bits;
+  const int code_bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(plan.top)));
+  for (int shift = F - 8; shift >= std::max(1, F - 14); --shift) {
+    const int offset_bits = shift + 1;
+    if (offset_bits + code_bits > 32) continue;
+    const std::int64_t width = std::int64_t{1} << shift;
+    const std::int64_t buckets = (one >> shift) + 1;
+    std::vector<std::uint32_t> index(static_cast<std::size_t>(rows * buckets));
+    bool fits = true;
+    for (std::int64_t r = 0; r < rows && fits; ++r) {
+      const std::int64_t* u = thresholds.data() + r * plan.top;
+      std::int64_t code = 0;  // thresholds at or below the bucket's lower end
+      for (std::int64_t q = 0; q < buckets; ++q) {
+        const std::int64_t lo = q * width;
+        while (code < plan.top && u[code] <= lo) ++code;
+        const std::int64_t next = code < plan.top ? u[code] - lo : width;
+        if (code + 1 < plan.top && u[code + 1] < lo + width) {  // two thresholds inside: too wide
+          fits = false;
+          break;
+        }
+        index[static_cast<std::size_t>(r * buckets + q)] =
+            (static_cast<std::uint32_t>(code) << offset_bits) | static_cast<std::uint32_t>(std::min(next, width));
+      }
+    }
+    if (!fits) continue;
+    plan.index = std::move(index);
+    plan.index_shift = shift;
+    plan.index_offset_bits = offset_bits;
+    plan.index_buckets = buckets;
+    return;
+  }
+}
 
 std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& channels) {
   DrivePlan d;
@@ -1140,6 +1254,7 @@ HWY_EXPORT(Compensate);
 HWY_EXPORT(GaussianColumns);
 HWY_EXPORT(GaussianRows);
 HWY_EXPORT(LcdDrive);
+HWY_EXPORT(LcdSearch);
 HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(StoreResiduals);
@@ -1166,6 +1281,10 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
                    int shift, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, out);
+}
+void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& plan,
+                std::uint16_t* codes) {
+  HWY_DYNAMIC_DISPATCH(LcdSearch)(target, rows, n, plan, codes);
 }
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
                         std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,

@@ -172,7 +172,21 @@ struct LcdPlan {
   std::vector<std::int64_t> end_dark;    // M(0, v_{t-1})^gamma, uQ/sQ.F
   std::vector<std::int64_t> end_bright;  // M(1, v_{t-1})^gamma
   bool contributed = false;              // LcdHistory::Contributed: x_{t-1} stored is the contributed value
+  // The search in one gather (lcd_search_index): per row r (v_{t-1} = r, then the held row) the code is the number
+  // of its thresholds U_k = ceil(merge[r][k] / scale) (the smallest target m with m scale >= merge) at or below m.
+  // Where every bucket of 2^index_shift targets holds at most one threshold besides its lower end, and every
+  // threshold lies in [1, one] (so a target clamped to [0, one] has its code), word [r index_buckets + q] holds the
+  // code at the bucket's lower end q 2^s, shifted left by index_offset_bits, above the offset from it of the row's
+  // next threshold (2^s where that is past the bucket). Empty otherwise: the binary search.
+  std::vector<std::uint32_t> index;
+  int index_shift = 0;
+  int index_offset_bits = 0;
+  std::int64_t index_buckets = 0;  // per row: (one >> s) + 1
 };
+
+// The per-row target index of an LCD plan (LcdPlan::index): the coarsest bucket width that holds at most one
+// threshold, from 2^(F-8) down to 2^(F-14) targets; none where no width does.
+void lcd_search_index(LcdPlan& plan);
 
 // What the line kernels need from a configuration, or nothing where its formats do not fit their lanes.
 struct FixedLinePlans {
@@ -223,6 +237,11 @@ void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight,
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
                         std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                         std::int64_t* shortfall);
+// The LCD drive's search alone (for tests): codes[s] = the largest k with merge[rows[s]][k] <= target[s] scale (row
+// rows[s] of the plan's merge table, the held row at 2^o), through LcdPlan::index where it is built, else by the
+// binary search, for target[s] in [0, one].
+void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& plan,
+                std::uint16_t* codes);
 // Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
 // whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions
 // of `kernels`.

@@ -582,6 +582,58 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
   }
 }
 
+// The LCD search through the per-row index against the binary search of the merge table, at every threshold of every
+// row (v_{t-1} = 0 .. 255 and the held row) and one target either side, at 0 and at one, on every instruction set;
+// at the default F and at F = 20.
+TEST(FixedLines, LcdIndexGivesTheBinarySearchsCodesAtEveryThreshold) {
+  for (const int linear_frac_bits : {28, 20}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
+    config.linear_frac_bits = linear_frac_bits;
+    config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
+    const fixed_detail::FixedKernels kernels(config);
+    ASSERT_TRUE(kernels.line_plans().lcd.has_value());
+    const fixed_detail::LcdPlan& indexed = *kernels.line_plans().lcd;
+    ASSERT_FALSE(indexed.index.empty()) << "F = " << linear_frac_bits;
+    fixed_detail::LcdPlan binary = indexed;
+    binary.index.clear();
+    const auto scale = static_cast<std::int64_t>(indexed.scale);
+    std::vector<std::int64_t> targets;
+    std::vector<std::int64_t> rows;
+    for (std::int64_t r = 0; r <= indexed.width; ++r) {
+      for (std::int64_t k = 1; k <= indexed.top; ++k) {
+        const std::int64_t u = (indexed.merge[static_cast<std::size_t>(r * indexed.width + k)] + scale - 1) / scale;
+        for (const std::int64_t t : {u - 1, u, u + 1}) {
+          targets.push_back(std::clamp<std::int64_t>(t, 0, indexed.one));
+          rows.push_back(r);
+        }
+      }
+      for (const std::int64_t t : {std::int64_t{0}, indexed.one}) {
+        targets.push_back(t);
+        rows.push_back(r);
+      }
+    }
+    targets.push_back(indexed.one / 3);  // a tail
+    rows.push_back(7);
+    // The binary search on scalars (no vector at all: n below one vector) gives the expected codes.
+    std::vector<std::uint16_t> expected(targets.size());
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      fixed_detail::lines::lcd_search(&targets[i], &rows[i], 1, binary, &expected[i]);
+    }
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      for (const fixed_detail::LcdPlan* plan : {&indexed, static_cast<const fixed_detail::LcdPlan*>(&binary)}) {
+        std::vector<std::uint16_t> codes(targets.size());
+        fixed_detail::lines::lcd_search(targets.data(), rows.data(), targets.size(), *plan, codes.data());
+        for (std::size_t i = 0; i < targets.size(); ++i) {
+          ASSERT_EQ(codes[i], expected[i]) << hwy::TargetName(target) << " F=" << linear_frac_bits
+                                           << (plan == &indexed ? " index" : " binary") << " row " << rows[i]
+                                           << " target " << targets[i];
+        }
+      }
+    }
+  }
+}
+
 // The formats the kernels take: the defaults at an 8-bit link (U's sums in 32-bit lanes) and an OLED drive; a 10-bit
 // link's U sums exceed 32 bits and an LCD drive is the merge search, so those keep the per-sample steps.
 TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
