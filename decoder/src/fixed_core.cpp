@@ -328,7 +328,9 @@ void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, con
   // The OR of the line's residual samples, accumulated as they are produced (one flip-flop) and kept as the line's
   // flag: a line held all zero is not written to the store.
   const int samples = 3 * eye.full_size.width;
-  const bool nonzero = std::any_of(residual_row, residual_row + samples, [](std::int32_t v) { return v != 0; });
+  std::int32_t any_bits = 0;  // an OR over the line, which the compiler vectorises (an all-zero line reads it all)
+  for (int i = 0; i < samples; ++i) any_bits |= residual_row[i];
+  const bool nonzero = any_bits != 0;
   eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
   // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel).
   eye.residual_grey[static_cast<std::size_t>(y)] = FixedKernels::grey_line(residual_row, eye.full_size.width) ? 1 : 0;

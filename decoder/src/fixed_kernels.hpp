@@ -218,12 +218,19 @@ class FixedKernels {
   // k, `samples` channel samples. kLineStatic: every code equals the stored one (so U of the two is the same).
   static constexpr std::uint8_t kLineStatic = 1;
   static std::uint8_t compare_line(const std::uint16_t* stored, const std::uint16_t* received, int samples);
-  // The grey detector of the chroma skip (DESIGN §7): R = G = B at every one of `pixels` interleaved pixels.
+  // The grey detector of the chroma skip (DESIGN §7): R = G = B at every one of `pixels` interleaved pixels. Blocks of
+  // pixels are ORed without a branch (which the compiler vectorises) and the comparator stops after the first block
+  // with a coloured pixel.
   template <typename T>
   static bool grey_line(const T* rgb, int pixels) {
-    bool grey = true;
-    for (int x = 0; x < pixels; ++x) grey &= (rgb[3 * x] == rgb[3 * x + 1]) & (rgb[3 * x] == rgb[3 * x + 2]);
-    return grey;
+    constexpr int kBlock = 64;
+    for (int start = 0; start < pixels; start += kBlock) {
+      const int end = std::min(pixels, start + kBlock);
+      T difference = 0;
+      for (int x = start; x < end; ++x) difference |= (rgb[3 * x] ^ rgb[3 * x + 1]) | (rgb[3 * x] ^ rgb[3 * x + 2]);
+      if (difference != 0) return false;
+    }
+    return true;
   }
 
   // OLED drive code: the largest k with x >= T_k (binary search of the threshold ROM).
