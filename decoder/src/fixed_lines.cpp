@@ -343,11 +343,11 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
     const std::size_t columns = plan.columns;
     const std::size_t length = plan.plane_length;
     thread_local std::vector<std::uint32_t> planes;
-    const std::size_t plane_samples = plan.plane_source.size();
+    const std::size_t plane_samples = 3 * f * length;
     planes.resize(plane_samples + lanes);
     // The planes from the row's channels over the columns c + j, j < f M (clamped at the row's ends): the row
     // deinterleaved into channels where the columns lie inside it, then each channel split into its f phases (at
-    // f = 2 by even and odd lanes). The same samples as plane_source names.
+    // f = 2 by even and odd lanes).
     const std::size_t span = f * length;
     thread_local std::vector<std::uint32_t> channel_rows;
     channel_rows.resize(3 * span + lanes);
@@ -1224,15 +1224,6 @@ GaussianColumnsPlan gaussian_columns_plan(const Geometry& g) {
   plan.full_width = full_width;
   plan.columns = columns;
   plan.plane_length = columns + (plan.taps - 1) / f;
-  plan.plane_source.resize(3 * f * plan.plane_length);
-  for (std::size_t ch = 0; ch < 3; ++ch) {
-    for (std::size_t p = 0; p < f; ++p) {
-      for (std::size_t m = 0; m < plan.plane_length; ++m) {
-        plan.plane_source[(ch * f + p) * plan.plane_length + m] =
-            3 * clamped(start + static_cast<std::int64_t>(f * m + p)) + static_cast<int>(ch);
-      }
-    }
-  }
   plan.planar_weight.assign(plan.taps * columns, 0);
   for (std::size_t k = 0; k < columns; ++k) {
     const PolyphaseTaps& taps = g.gauss_cols[k];

@@ -102,7 +102,6 @@ struct GaussianColumnsPlan {
   std::size_t decimation = 0;          // f
   std::size_t columns = 0;             // reduced width K
   std::size_t plane_length = 0;        // M = K + (taps - 1) div f
-  std::vector<std::int32_t> plane_source;     // [(ch f + p) M + m]: the row sample of plane (ch, p) at m
   std::int64_t first_column = 0;  // c: plane (ch, p) at m holds column clamp(c + f m + p) of the row's full_width
   std::size_t full_width = 0;
   std::vector<std::uint32_t> planar_weight;   // [t K + k]: tap slot t's weight of column k (every channel's)
@@ -152,9 +151,9 @@ struct MotionTally {
 
 struct ResidualTally;  // fixed_kernels.hpp
 
-// The LCD drive (FixedKernels::lcd_drive after the eye's first frame, and emit's frame-store update): the target
-// m = ((x_t + x_{t-1}) / 2)^(1/gamma) through the octave-segmented ROM, the binary search over the merge table's row
-// v_{t-1}, and the unreachable ends.
+// The LCD drive (FixedKernels::lcd_drive, the eye's first (held) frame included, and emit's frame-store update): the
+// target m = ((x_t + x_{t-1}) / 2)^(1/gamma) through the octave-segmented ROM, the code of m in the merge table's row
+// v_{t-1} (through the per-row index below where it is built, else by binary search), and the unreachable ends.
 struct LcdPlan {
   std::vector<std::int64_t> target_packed;  // the target ROM as EotfPlan::packed
   int target_shift = 0;                     // the sum's bits below the ROM's input code

@@ -360,8 +360,9 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
 // FixedKernels::drive_code, value by value: every channel's thresholds and their neighbours, both sides of 2^24 (where
 // the 32-bit lanes' float conversion changes form), every octave, random values, and values outside [0, 1] (the
 // generic search), on every instruction set.
-// Both output depths: at 10 bits the index needs up to three steps (the two-gather search); at 8 bits one, which
-// takes the packed single gather (DrivePlan::packed32), and the two-gather search of the same tables beside it.
+// Both output depths: at 10 bits the index needs up to three steps (the base gather and three threshold gathers); at
+// 8 bits one, which takes the packed single gather (DrivePlan::packed32), and the stepped search of the same tables
+// beside it.
 TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
   for (const int output_bits : {10, 8}) {
     const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive", output_bits);
@@ -560,23 +561,29 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
       expected_store_linear[s] = static_cast<std::int32_t>(history == LcdHistory::Contributed ? sample.contributed : wanted[s]);
     }
     EXPECT_GT(expected_unreachable, 0u) << "the operands reach the unreachable ends";
+    ASSERT_FALSE(plan->index.empty()) << "the per-row index is built";
+    fixed_detail::LcdPlan binary = *plan;  // the binary search of the merge table, where no index is built
+    binary.index.clear();
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
-      const TargetMock mock(target);
-      const std::string where = std::string(hwy::TargetName(target)) +
-                                (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
-                                std::to_string(linear_frac_bits) + (held ? " held" : "");
-      std::vector<std::uint16_t> store_code(previous_code), codes(kSamples);
-      std::vector<std::int32_t> store_linear(previous_linear);
-      std::vector<std::int64_t> shortfall(kSamples);
-      const std::uint64_t unreachable = fixed_detail::lines::lcd_drive(
-          wanted.data(), kSamples, *plan, kernels, store_code.data(), store_linear.data(), held, codes.data(),
-          shortfall.data());
-      EXPECT_EQ(unreachable, expected_unreachable) << where;
-      for (std::size_t s = 0; s < kSamples; ++s) {
-        ASSERT_EQ(codes[s], expected_codes[s]) << where << " sample " << s << " wanted " << wanted[s];
-        ASSERT_EQ(shortfall[s], expected_shortfall[s]) << where << " sample " << s;
-        ASSERT_EQ(store_code[s], expected_store_code[s]) << where << " sample " << s;
-        ASSERT_EQ(store_linear[s], expected_store_linear[s]) << where << " sample " << s;
+      for (const fixed_detail::LcdPlan* searched : {&*plan, static_cast<const fixed_detail::LcdPlan*>(&binary)}) {
+        const TargetMock mock(target);
+        const std::string where = std::string(hwy::TargetName(target)) +
+                                  (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
+                                  std::to_string(linear_frac_bits) + (held ? " held" : "") +
+                                  (searched == &binary ? " binary search" : " index");
+        std::vector<std::uint16_t> store_code(previous_code), codes(kSamples);
+        std::vector<std::int32_t> store_linear(previous_linear);
+        std::vector<std::int64_t> shortfall(kSamples);
+        const std::uint64_t unreachable = fixed_detail::lines::lcd_drive(
+            wanted.data(), kSamples, *searched, kernels, store_code.data(), store_linear.data(), held, codes.data(),
+            shortfall.data());
+        EXPECT_EQ(unreachable, expected_unreachable) << where;
+        for (std::size_t s = 0; s < kSamples; ++s) {
+          ASSERT_EQ(codes[s], expected_codes[s]) << where << " sample " << s << " wanted " << wanted[s];
+          ASSERT_EQ(shortfall[s], expected_shortfall[s]) << where << " sample " << s;
+          ASSERT_EQ(store_code[s], expected_store_code[s]) << where << " sample " << s;
+          ASSERT_EQ(store_linear[s], expected_store_linear[s]) << where << " sample " << s;
+        }
       }
     }
   }
@@ -585,7 +592,7 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
 // The LCD search through the per-row index against the binary search of the merge table, at every threshold of every
 // row (v_{t-1} = 0 .. 255 and the held row) and one target either side, at 0 and at one, on every instruction set;
 // at the default F and at F = 20.
-TEST(FixedLines, LcdIndexGivesTheBinarySearchsCodesAtEveryThreshold) {
+TEST(FixedLines, LcdIndexGivesTheBinarySearchCodesAtEveryThreshold) {
   for (const int linear_frac_bits : {28, 20}) {
     FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
     config.linear_frac_bits = linear_frac_bits;
@@ -645,6 +652,8 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   EXPECT_TRUE(plans_of(oled).drive.has_value());
   EXPECT_TRUE(plans_of(oled).motion.has_value());
   EXPECT_TRUE(plans_of(oled).gaussian.has_value());
+  EXPECT_FALSE(plans_of(oled).code_rom32.empty()) << "lin(E) gathered as 32-bit words";
+  EXPECT_FALSE(plans_of(oled).drive->packed32.empty()) << "the OLED drive search in one gather at 8 bits";
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).gaussian.has_value());
   FixedDecoderConfig still = oled;
   still.decoder.sensitivity = 0.0;  // w = 1 everywhere: the stage function's shortcut

@@ -180,7 +180,6 @@ TEST(TrmEncoder, RejectsInvalidFrames) {
 }  // namespace
 }  // namespace trm
 
-// One writer and one reader of the encoder configuration (capture headers, reports).
 // highest_code against cv::minMaxLoc (the check it replaces): random codes of every width, 1 and 3 channels, the
 // largest code anywhere in a row (first, last, a row's middle), a region of a larger image (rows not contiguous, the
 // region's neighbours higher than anything inside it), empty; another depth is refused.
@@ -212,6 +211,7 @@ TEST(HighestCode, AgreesWithMinMaxLocAndReadsOnlyTheImage) {
   EXPECT_THROW(trm::highest_code(cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(1))), std::invalid_argument);
 }
 
+// One writer and one reader of the encoder configuration (capture headers, reports).
 TEST(EncoderJson, RoundTripsAndRefusesWhatTheCommandLineWouldRefuse) {
   trm::EncoderConfig config;
   config.reduction = 0.25;

@@ -20,11 +20,11 @@ int run_main(int argc, char** argv) {
   // thread receives them.
   io::install_signal_cleanup();
 #if defined(__GLIBC__)
-  // Frame-sized buffers stay in the process's heap once freed instead of going back to the kernel: glibc serves blocks
-  // of 32 MiB and more (a 2160x1200 double plane is 59 MiB) by mmap, unmaps them on free and trims the heap's top, so
-  // every frame faulted its buffers in again page by page (about 10 us a page on a virtual machine; the OpenCV
-  // pipeline of `trm bench` ran at 4.3 Mpix/s so and at 36 without, docs/performance_history.md). The resident set
-  // stays at its peak; malloc_trim still gives the free pages back.
+  // Frame-sized buffers stay in the process's heap once freed instead of going back to the kernel. By default glibc
+  // serves large blocks (a 2160x1200 double plane is 59 MiB) by mmap, unmaps them on free and trims the heap's top,
+  // so every frame faulted its buffers in again page by page: about 10 us a page on a virtual machine, where the
+  // OpenCV pipeline of `trm bench` ran at 4.3 Mpix/s with the default and at 36 with this (docs/performance_history.md).
+  // The resident set stays at its peak; malloc_trim still gives the free pages back.
   mallopt(M_MMAP_MAX, 0);
   mallopt(M_TRIM_THRESHOLD, -1);
 #endif
