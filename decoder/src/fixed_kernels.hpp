@@ -201,6 +201,18 @@ class FixedKernels {
   // also the report drive value v (else LcdSample::drive stays 0).
   LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
                       bool drive_value = true) const;
+  // lcd_drive's search: the largest k in [0, top] with merge_at(k) <= target_scaled (merge_at(k) = M(T_k, v_{t-1})
+  // scaled, increasing in k; k = 0 is not read), by binary comparison.
+  template <typename MergeAt>
+  static int merge_search(int top, Raw target_scaled, MergeAt merge_at) {
+    int lo = 0;
+    int hi = top;
+    while (lo < hi) {
+      const int mid = (lo + hi + 1) / 2;
+      if (target_scaled >= merge_at(mid)) lo = mid; else hi = mid - 1;
+    }
+    return lo;
+  }
 
   // Rec. 709 luma of linear RGB (uQ1.F each); uQ1.F.
   Raw luma(const Raw* rgb) const;

@@ -521,16 +521,11 @@ void LcdSearch(const std::int64_t* target, const std::int64_t* rows, std::size_t
     hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, code)), d16, codes + s);
   }
 #endif
-  for (; s < n; ++s) {  // the binary search of FixedKernels::lcd_drive
+  for (; s < n; ++s) {  // the search of FixedKernels::lcd_drive
     const std::int64_t* row = p.merge.data() + rows[s] * p.width;
-    const std::int64_t scaled = target[s] * static_cast<std::int64_t>(p.scale);
-    int lo = 0;
-    int hi = p.top;
-    while (lo < hi) {
-      const int mid = (lo + hi + 1) / 2;
-      if (scaled >= row[mid]) lo = mid; else hi = mid - 1;
-    }
-    codes[s] = static_cast<std::uint16_t>(lo);
+    const int code = FixedKernels::merge_search(p.top, target[s] * static_cast<std::int64_t>(p.scale),
+                                                [row](int k) { return row[k]; });
+    codes[s] = static_cast<std::uint16_t>(code);
   }
 }
 
@@ -1039,13 +1034,7 @@ void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, D
   for (const ThresholdIndex* index : channels) {
     const std::vector<std::int64_t>& padded = index->padded();
     for (std::size_t b = 0; b < index->base().size(); ++b) {
-      std::int64_t lo = static_cast<std::int64_t>(b);
-      std::int64_t width = 1;
-      if (b >= (std::size_t{1} << m)) {
-        const int lead = static_cast<int>(b >> m) + m - 1;
-        lo = ((std::int64_t{1} << m) + static_cast<std::int64_t>(b & ((std::size_t{1} << m) - 1))) << (lead - m);
-        width = std::int64_t{1} << (lead - m);
-      }
+      const auto [lo, width] = ThresholdIndex::bucket_range(b);
       const std::uint16_t k = index->base()[b];
       const std::int64_t next = padded[std::size_t{k} + 1];  // above lo (k is lo's code); the padding is INT64_MAX
       if (next <= lo) return;

@@ -170,14 +170,9 @@ LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t
   const Raw target_scaled = target * (two_top * two_top);  // m (2 Mx)^2 2^F, as scaled_merge
   // row: the threshold merges of this v_{t-1} from lcd_merge_table_ (null: computed per step).
   const auto search = [&](const std::array<Raw, 4>& p, Raw j, const Raw* row) {
-    int lo = 0;
-    int hi = top;
-    while (lo < hi) {  // the largest k with M(T_k, vp) <= m (M increases with T)
-      const int mid = (lo + hi + 1) / 2;
-      const Raw merge = row != nullptr ? row[mid] : scaled_merge(p, 2 * static_cast<Raw>(mid) - 1, j);
-      if (target_scaled >= merge) lo = mid; else hi = mid - 1;
-    }
-    return lo;
+    return merge_search(top, target_scaled, [&](int k) {  // M(T_k, vp) increases with T
+      return row != nullptr ? row[k] : scaled_merge(p, 2 * static_cast<Raw>(k) - 1, j);
+    });
   };
   const std::size_t width = static_cast<std::size_t>(top) + 1;
   const auto table_row = [&](std::size_t row) {

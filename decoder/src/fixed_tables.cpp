@@ -36,14 +36,9 @@ ThresholdIndex::ThresholdIndex(std::vector<std::int64_t> thresholds, int value_b
   base_.resize(buckets);
   int steps = 0;
   for (std::size_t b = 0; b < buckets; ++b) {
-    std::int64_t lo = static_cast<std::int64_t>(b);
-    std::int64_t hi = lo;
-    if (b >= (std::size_t{1} << kMantissaBits)) {
-      const int lead = static_cast<int>(b >> kMantissaBits) + kMantissaBits - 1;
-      const std::int64_t mantissa = static_cast<std::int64_t>(b & ((std::size_t{1} << kMantissaBits) - 1));
-      lo = ((std::int64_t{1} << kMantissaBits) + mantissa) << (lead - kMantissaBits);
-      hi = lo + (std::int64_t{1} << (lead - kMantissaBits)) - 1;
-    }
+    const BucketRange range = bucket_range(b);
+    const std::int64_t lo = range.lo;
+    const std::int64_t hi = range.lo + range.width - 1;
     base_[b] = threshold_search(thresholds_, lo);
     steps = std::max(steps, static_cast<int>(threshold_search(thresholds_, hi)) - static_cast<int>(base_[b]));
   }

@@ -51,6 +51,18 @@ class ThresholdIndex {
     for (int i = 0; i < steps_; ++i) k += x >= padded_[k + 1] ? 1 : 0;
     return static_cast<std::uint16_t>(k);
   }
+  // The values bucket b covers: [lo, lo + width) (width 1 below 2^kMantissaBits, where x is its own bucket).
+  struct BucketRange {
+    std::int64_t lo = 0;
+    std::int64_t width = 1;
+  };
+  static BucketRange bucket_range(std::size_t b) {
+    if (b < (std::size_t{1} << kMantissaBits)) return {static_cast<std::int64_t>(b), 1};
+    const int lead = static_cast<int>(b >> kMantissaBits) + kMantissaBits - 1;
+    const auto mantissa = static_cast<std::int64_t>(b & ((std::size_t{1} << kMantissaBits) - 1));
+    return {((std::int64_t{1} << kMantissaBits) + mantissa) << (lead - kMantissaBits),
+            std::int64_t{1} << (lead - kMantissaBits)};
+  }
   // The index itself, for the vectorised search (fixed_lines.hpp); steps() == 0: not usable.
   int steps() const { return steps_; }
   int value_bits() const { return value_bits_; }

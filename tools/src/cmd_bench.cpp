@@ -133,7 +133,7 @@ struct Contender {
   int threads = 1;
   std::function<std::function<void(const LinkFrame&)>()> make;
   std::vector<double> seconds;      // per repeat
-  std::vector<double> first_pair_seconds;  // per repeat: the fresh decoder's first pair, untimed above
+  std::vector<double> first_pair_seconds;  // per repeat: the fresh decoder's first pair, timed apart before `seconds`
   std::vector<double> cpu_seconds;  // per repeat, every thread of the process (steadier than wall time on a loaded
                                     // machine; the machine's other processes are not in it)
   double peak_rss_mib = 0.0;
