@@ -351,7 +351,8 @@ void BM_LineLcdDrive(benchmark::State& state) {
   const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 14);
   const std::vector<std::uint16_t> previous_codes = random_codes(3 * kWidth, kernels.max_output_code(), 15);
   std::vector<std::int32_t> store_linear(previous.size());
-  std::vector<std::uint16_t> store_codes(previous_codes.size()), codes(wanted.size());
+  std::vector<std::uint8_t> store_codes(previous_codes.size());  // the 8-bit v_{t-1} store
+  std::vector<std::uint16_t> codes(wanted.size());
   for (auto _ : state) {
     state.PauseTiming();
     std::copy(previous.begin(), previous.end(), store_linear.begin());

@@ -101,7 +101,7 @@ void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
   out.lcd_held = eye.lcd_previous_drive.empty();
   if (out.lcd_held) {
     // Not read on the held frame (lcd_drive takes x_{t-1} = x_t and the held code); zeroed to stay defined.
-    eye.lcd_previous_drive = frame_plane(eye.full_size, CV_16UC3);
+    eye.lcd_previous_drive = frame_plane(eye.full_size, kernels_.max_output_code() <= 255 ? CV_8UC3 : CV_16UC3);
     eye.lcd_previous_linear = frame_plane(eye.full_size, CV_32SC3);
     eye.lcd_previous_drive.setTo(0);
     eye.lcd_previous_linear.setTo(0);
@@ -122,8 +122,11 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
     return 0;
   }
   // LCD frame stores: v_{t-1} and x_{t-1} at this sample are read, then replaced by this frame's.
-  std::uint16_t& previous_code = eye.lcd_previous_drive.ptr<std::uint16_t>(y)[k];
+  const bool narrow_store = eye.lcd_previous_drive.depth() == CV_8U;
+  std::uint8_t* previous_code8 = narrow_store ? eye.lcd_previous_drive.ptr<std::uint8_t>(y) + k : nullptr;
+  std::uint16_t* previous_code16 = narrow_store ? nullptr : eye.lcd_previous_drive.ptr<std::uint16_t>(y) + k;
   std::int32_t& previous_linear = eye.lcd_previous_linear.ptr<std::int32_t>(y)[k];
+  const std::uint16_t previous_code = narrow_store ? *previous_code8 : *previous_code16;
   const LcdSample s = kernels_.lcd_drive(wanted, previous_linear, previous_code, out.lcd_held, planes);
   out.frame.drive_codes.ptr<std::uint16_t>(y)[k] = s.code;
   out.tally.counts.lcd_unreachable += s.unreachable ? 1 : 0;
@@ -132,7 +135,11 @@ Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch
     out.frame.drive.ptr<double>(y)[k] = kernels_.drive_to_double(s.drive);
     out.frame.emitted_linear.ptr<double>(y)[k] = kernels_.emitted(s.code, s.previous_code, ch);
   }
-  previous_code = s.code;
+  if (narrow_store) {
+    *previous_code8 = static_cast<std::uint8_t>(s.code);
+  } else {
+    *previous_code16 = s.code;
+  }
   previous_linear = static_cast<std::int32_t>(contributed ? s.contributed : wanted);
   return out.full ? s.shortfall : 0;
 }
@@ -271,7 +278,7 @@ void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const R
   }
   if (plans.lcd) {
     out.tally.counts.lcd_unreachable += lines::lcd_drive(
-        shown, n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint16_t>(y),
+        shown, n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
         eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
         shortfall);
     return;

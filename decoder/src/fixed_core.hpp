@@ -46,7 +46,8 @@ struct FrameTally {
 // What persists between frames of one eye (DESIGN §5 frame stores).
 struct EyeState {
   cv::Size full_size;
-  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} codes, full size, CV_16UC3 (empty: no history yet)
+  cv::Mat lcd_previous_drive;   // LCD: v_{t-1} codes, full size, CV_8UC3 up to 8-bit output, else CV_16UC3 (empty:
+                                // no history yet)
   cv::Mat lcd_previous_linear;  // LCD: x_{t-1}, full size, CV_32SC3 sQ.F
   bool have_residual = false;
   std::int64_t residual_index = 0;

@@ -531,18 +531,18 @@ void LcdSearch(const std::int64_t* target, const std::int64_t* rows, std::size_t
 
 // One sample of the LCD drive by the stage function, with emit's frame-store update.
 inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const FixedKernels& kernels,
-                                std::uint16_t& previous_code, std::int32_t& previous_linear, bool held,
+                                std::uint8_t& previous_code, std::int32_t& previous_linear, bool held,
                                 std::int64_t* shortfall, std::uint64_t& unreachable) {
   const LcdSample sample = kernels.lcd_drive(wanted, previous_linear, previous_code, held, false);
   unreachable += sample.unreachable ? 1 : 0;
   if (shortfall != nullptr) *shortfall = sample.shortfall;
-  previous_code = sample.code;
+  previous_code = static_cast<std::uint8_t>(sample.code);
   previous_linear = static_cast<std::int32_t>(p.contributed ? sample.contributed : wanted);
   return sample.code;
 }
 
 std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
-                       std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                       std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                        std::int64_t* shortfall) {
   std::uint64_t unreachable = 0;
   std::size_t s = 0;
@@ -554,6 +554,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const hn::Rebind<std::int32_t, decltype(d)> d32;
   const hn::Rebind<std::uint32_t, decltype(du)> du32h;
   const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const hn::Rebind<std::uint8_t, decltype(du)> d8;
   const hn::Rebind<double, decltype(d)> df;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
@@ -596,7 +597,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
                      : LcdBinarySearch(d, p, target_scaled, hn::ShiftLeftSame(row, p.width_log2));
     };
     const auto j = held ? search(held_row)
-                        : hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d16, previous_code + s))));
+                        : hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d8, previous_code + s))));
     const auto lo = search(j);
     const auto end_dark = hn::GatherIndex(d, p.end_dark.data(), j);
     const auto end_bright = hn::GatherIndex(d, p.end_bright.data(), j);
@@ -610,7 +611,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + s);
     const auto stored = p.contributed ? contributed : x;
     hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + s);
-    hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, previous_code + s);
+    hn::StoreU(hn::TruncateTo(d8, hn::BitCast(du, drive)), d8, previous_code + s);
     hn::StoreU(hn::BitCast(d32, hn::TruncateTo(du32h, hn::BitCast(du, stored))), d32, previous_linear + s);
   }
 #endif
@@ -1267,7 +1268,7 @@ void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_
   HWY_DYNAMIC_DISPATCH(LcdSearch)(target, rows, n, plan, codes);
 }
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
-                        std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                        std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                         std::int64_t* shortfall) {
   return HWY_DYNAMIC_DISPATCH(LcdDrive)(wanted, n, plan, kernels, previous_code, previous_linear, held, codes,
                                         shortfall);

@@ -232,9 +232,10 @@ void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight,
 // The LCD drive of n samples of one line: codes[s] and, where shortfall is not null, shortfall[s] as
 // FixedKernels::lcd_drive(wanted[s], previous_linear[s], previous_code[s], held) gives them, and the frame stores
 // previous_code / previous_linear replaced as FixedDecoderCore::emit replaces them (held: the eye's first frame,
-// whose stores are written and not read). Returns the number of unreachable samples.
+// whose stores are written and not read; v_{t-1} in 8 bits, the plan's widest output). Returns the number of
+// unreachable samples.
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
-                        std::uint16_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                        std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
                         std::int64_t* shortfall);
 // The LCD drive's search alone (for tests): codes[s] = the largest k with merge[rows[s]][k] <= target[s] scale (row
 // rows[s] of the plan's merge table, the held row at 2^o), through LcdPlan::index where it is built, else by the

@@ -538,16 +538,17 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
     std::uniform_int_distribution<int> octave(0, linear_frac_bits);
     std::vector<std::int64_t> wanted(kSamples);
     std::vector<std::int32_t> previous_linear(kSamples);
-    std::vector<std::uint16_t> previous_code(kSamples);
+    std::vector<std::uint8_t> previous_code(kSamples);  // the 8-bit v_{t-1} store
     for (std::size_t s = 0; s < kSamples; ++s) {
       // Every third sample small, spread over the octaves (down to the ROM's bottom region), others uniform.
       wanted[s] = s % 3 == 0 ? (std::int64_t{1} << octave(random)) + (s % 7) : linear(random);
       previous_linear[s] = static_cast<std::int32_t>(s % 5 == 0 ? -(linear(random) / 8) : linear(random));
       if (s % 11 == 0) wanted[s] = previous_linear[s] = 0;
       if (s % 13 == 0) wanted[s] = one, previous_linear[s] = static_cast<std::int32_t>(one);
-      previous_code[s] = static_cast<std::uint16_t>(random() % 256);
+      previous_code[s] = static_cast<std::uint8_t>(random() % 256);
     }
-    std::vector<std::uint16_t> expected_codes(kSamples), expected_store_code(previous_code);
+    std::vector<std::uint16_t> expected_codes(kSamples);
+    std::vector<std::uint8_t> expected_store_code(previous_code);
     std::vector<std::int32_t> expected_store_linear(previous_linear);
     std::vector<std::int64_t> expected_shortfall(kSamples);
     std::uint64_t expected_unreachable = 0;
@@ -557,7 +558,7 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
       expected_codes[s] = sample.code;
       expected_shortfall[s] = sample.shortfall;
       expected_unreachable += sample.unreachable ? 1 : 0;
-      expected_store_code[s] = sample.code;
+      expected_store_code[s] = static_cast<std::uint8_t>(sample.code);
       expected_store_linear[s] = static_cast<std::int32_t>(history == LcdHistory::Contributed ? sample.contributed : wanted[s]);
     }
     EXPECT_GT(expected_unreachable, 0u) << "the operands reach the unreachable ends";
@@ -571,7 +572,8 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
                                   (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
                                   std::to_string(linear_frac_bits) + (held ? " held" : "") +
                                   (searched == &binary ? " binary search" : " index");
-        std::vector<std::uint16_t> store_code(previous_code), codes(kSamples);
+        std::vector<std::uint8_t> store_code(previous_code);
+        std::vector<std::uint16_t> codes(kSamples);
         std::vector<std::int32_t> store_linear(previous_linear);
         std::vector<std::int64_t> shortfall(kSamples);
         const std::uint64_t unreachable = fixed_detail::lines::lcd_drive(
