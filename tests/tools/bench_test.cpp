@@ -68,8 +68,48 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
     }
     EXPECT_EQ(names, (std::set<std::string>{"fixed", "fixed-1t", "fixed+planes", "fixed-frame", "reference",
                                               "opencv-float32"}));
+    // DESIGN §6 on the bench's own views: the verdict is the criterion applied to the figures beside it, and at the
+    // default formats it is met.
+    const nlohmann::json& agreement = r["reference_agreement"];
+    expect_positive(agreement["codes"], "agreement codes");
+    const double identical = agreement["identical_percent"].get<double>();
+    EXPECT_GE(identical, 0.0);
+    EXPECT_LE(identical, 100.0);
+    const double max_lsb = agreement["max_lsb"].get<double>();
+    EXPECT_EQ(agreement["meets_design_6"].get<bool>(), identical >= 99.9 && max_lsb <= 1.0) << agreement.dump();
+    EXPECT_TRUE(agreement["meets_design_6"].get<bool>()) << r["panel"] << " " << agreement.dump();
+    EXPECT_EQ(agreement["lcd_synchronised"].get<bool>(), r["panel"] == "lcd");
   }
   EXPECT_EQ(panels, (std::set<std::string>{"vive", "lcd"}));
+  EXPECT_TRUE(report["parameters"]["formats"].empty());
+}
+
+// --format sets the fixed-point decoders' formats by trm sweep's knobs and is recorded; the §6 check then judges
+// those formats: linear light uQ1.16 cannot tell the darkest drive codes apart and is rejected before any work,
+// and a set that is accepted is held to the reference like the defaults.
+TEST(Bench, FormatSetsAreAppliedCheckedAndRecorded) {
+  ScratchDir dir("trm_bench_format_");
+  const std::string json_path = dir.str("bench.json");
+  const auto narrow = run_trm("bench --quick --size 128x96 --panel vive --only fixed --format linear_frac_bits=18 "
+                              "--format bilinear_weight_frac_bits=8 --json " + json_path);
+  ASSERT_EQ(narrow.exit_code, 0) << narrow.output;
+  EXPECT_NE(narrow.output.find("linear_frac_bits=18 bilinear_weight_frac_bits=8"), std::string::npos) << narrow.output;
+  std::ifstream in(json_path);
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["parameters"]["formats"],
+            nlohmann::json::array({"linear_frac_bits=18", "bilinear_weight_frac_bits=8"}));
+  ASSERT_EQ(report["results"].size(), 1u);
+  expect_positive(report["results"][0]["reference_agreement"]["codes"], "agreement codes");
+
+  const std::string rejected_path = dir.str("rejected.json");
+  for (const std::string bad : {"linear_frac_bits=16", "no_such_knob=3", "linear_frac_bits", "residual_bits=x",
+                                 "eye_substeps=2", "linear_resample_frac_bits=24"}) {
+    const auto result = run_trm("bench --quick --format " + bad + " --json " + rejected_path);
+    EXPECT_NE(result.exit_code, 0) << bad;
+    EXPECT_NE(result.output.find("--format"), std::string::npos) << bad << ": " << result.output;
+    EXPECT_EQ(result.output.find("Mpix/s"), std::string::npos) << bad << ": rejected before any work";
+    EXPECT_FALSE(std::ifstream(rejected_path).good()) << bad;
+  }
 }
 
 }  // namespace

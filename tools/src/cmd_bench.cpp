@@ -3,6 +3,7 @@
 // encoded views at headset sizes, beside the resource report's memory (issue 13).
 #include "commands.hpp"
 #include "hw_report.hpp"
+#include "sweep.hpp"
 
 #include "opencv_trm.hpp"
 
@@ -10,11 +11,14 @@
 #include "trm/decoder.hpp"
 #include "trm/encoder.hpp"
 #include "trm/fixed_decoder.hpp"
+#include "trm/metrics.hpp"
+#include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
 
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -58,7 +62,57 @@ struct BenchOptions {
   std::vector<std::string> panels;  // empty: vive and lcd
   int threads = 0;                  // the streaming decoder's threads; 0: the machine's hardware threads
   std::vector<std::string> only;    // contenders to time besides the OpenCV yardstick; empty: all
+  std::vector<std::string> formats;  // KNOB=VALUE: a format set of the fixed-point decoders (trm sweep's knobs)
 };
+
+// A fixed-point format set from --format KNOB=VALUE, by `trm sweep`'s knobs (one home for their names and for how
+// each sets the configuration), applied in order onto `config`. Throws std::invalid_argument naming the bad entry:
+// not KNOB=VALUE, an unknown knob (the known ones listed), an eye-model knob, a knob of the linear resample space
+// (the bench decodes in the encoded space), a value that is not a whole number, or a configuration the decoder
+// rejects (its stage and rule).
+void apply_formats(FixedDecoderConfig& config, const std::vector<std::string>& formats) {
+  for (const std::string& entry : formats) {
+    const std::size_t equals = entry.find('=');
+    const std::string name = entry.substr(0, equals);
+    const SweepKnob* knob = find_sweep_knob(name);
+    if (equals == std::string::npos || knob == nullptr || knob->eye_model || knob->linear_space_only) {
+      std::string known;
+      for (const SweepKnob& k : sweep_knobs()) {
+        if (!k.eye_model && !k.linear_space_only) known.append(known.empty() ? "" : ", ").append(k.name);
+      }
+      const std::string why = equals == std::string::npos ? "expected KNOB=VALUE"
+                              : knob == nullptr           ? "unknown knob '" + name + "'"
+                              : knob->eye_model           ? "'" + name + "' is a knob of the eye model, not of the decoder"
+                                                          : "'" + name + "' is a knob of the linear resample space; trm "
+                                                            "bench decodes in the encoded space";
+      throw std::invalid_argument("--format '" + entry + "': " + why + "; knobs: " + known);
+    }
+    const std::string text = entry.substr(equals + 1);
+    int value = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+      throw std::invalid_argument("--format '" + entry + "': the value must be a whole number");
+    }
+    SweepConfig sweep_config{config};
+    try {
+      knob->set(sweep_config, value);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--format '" + entry + "': " + e.what());
+    }
+    config = sweep_config.decoder;
+  }
+  try {
+    config.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--format: ") + e.what());
+  }
+}
+
+std::string formats_label(const std::vector<std::string>& formats) {
+  std::string label;
+  for (const std::string& f : formats) label.append(label.empty() ? "" : " ").append(f);
+  return label.empty() ? "default formats" : label;
+}
 
 // Every contender's name, in the order they are listed; the OpenCV decoder is the yardstick of every ratio and is
 // always timed.
@@ -140,12 +194,42 @@ struct Contender {
   double rss_before_mib = 0.0;
 };
 
-FixedDecoderConfig config_for(const BenchSize& size, const std::string& panel) {
+FixedDecoderConfig config_for(const BenchSize& size, const std::string& panel, const std::vector<std::string>& formats) {
   FixedDecoderConfig config;
   config.decoder.link.reduction = 0.5;
   config.decoder.link.stereo = size.stereo;
   config.decoder.panel = parse_panel(panel);
+  apply_formats(config, formats);
   return config;
+}
+
+// DESIGN §6 at the bench's formats on the bench's views: the streaming decoder's drive codes against the reference's.
+// An LCD reference adopts the fixed decoder's codes as its panel history after every view (the synchronised
+// comparison the criterion is judged on: README "Accuracy").
+Json reference_agreement(const FixedDecoderConfig& config, const std::vector<LinkFrame>& views, std::ostream& text) {
+  FixedDecoderConfig codes_only = config;
+  codes_only.report_planes = false;
+  const std::unique_ptr<HeadsetDecoder> fixed = make_decoder("fixed", codes_only);
+  const std::unique_ptr<HeadsetDecoder> reference = make_decoder("reference", config);
+  auto* const synchronised = dynamic_cast<ReferenceDecoder*>(reference.get());
+  const bool lcd = config.decoder.panel.has_history();
+  CodeAgreement codes;
+  for (const LinkFrame& view : views) {
+    const DecodedFrame decoded = fixed->decode(view);
+    codes += compare_codes(decoded.drive_codes, reference->decode(view).drive_codes);
+    if (lcd && synchronised != nullptr) synchronised->adopt_panel_history(decoded);
+  }
+  const bool met = kReferenceAgreementCriterion.met_by(codes);
+  text << "  DESIGN §6, fixed against the reference" << (lcd ? " (synchronised)" : "") << ": " << std::setprecision(4)
+       << codes.identical_percent() << " % of " << codes.compared << " codes identical, max " << std::setprecision(0)
+       << codes.max_lsb << " LSB: " << (met ? "met" : "NOT met") << " (>= "
+       << std::setprecision(1) << kReferenceAgreementCriterion.min_identical_percent() << " %, max "
+       << std::setprecision(0) << kReferenceAgreementCriterion.max_lsb << " LSB)\n";
+  return {{"codes", codes.compared},
+          {"identical_percent", codes.identical_percent()},
+          {"max_lsb", codes.max_lsb},
+          {"lcd_synchronised", lcd},
+          {"meets_design_6", met}};
 }
 
 std::vector<LinkFrame> encode_views(const BenchSize& size, const BenchOptions& options,
@@ -178,7 +262,7 @@ Json hardware_memory(const FixedDecoderConfig& config, const BenchSize& size) {
 }
 
 Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptions& options, std::ostream& text) {
-  const FixedDecoderConfig config = config_for(size, panel);
+  const FixedDecoderConfig config = config_for(size, panel, options.formats);
   const std::vector<LinkFrame> views = encode_views(size, options, config.decoder.link);
   std::vector<Contender> contenders;
   // The hardware model's output is the drive codes: the streaming decoder without the report planes, on the
@@ -254,7 +338,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                  {"output_mpix_per_frame", frame_pixels / 1e6},
                  {"hw_report_memory", hardware_memory(config, size)}};
   text << "\n" << size.label() << ", " << panel << ", r = 0.5, " << options.scene << ", "
-       << static_cast<int>(link_frames) << " frames, median of " << repeats << "\n";
+       << static_cast<int>(link_frames) << " frames, median of " << repeats << ", " << formats_label(options.formats)
+       << "\n";
   text << "  " << std::left << std::setw(16) << "decoder" << std::right << std::setw(9) << "Mpix/s" << std::setw(11)
        << "ms/frame" << std::setw(10) << "vs cv" << std::setw(9) << "RT@90" << std::setw(9) << "RT@120"
        << std::setw(9) << "RT@144" << std::setw(9) << "threads" << std::setw(11) << "peak MiB" << std::setw(11) << "work MiB" << std::setw(13) << "cpu ms/frame" << std::setw(15) << "1st pair ms" << "\n";
@@ -300,6 +385,7 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
           "decoder was built, after the heap's free pages went back; fixed+planes, fixed-frame and reference also "
           "return three double planes per view)\n";
   result["decoders"] = std::move(decoders);
+  result["reference_agreement"] = reference_agreement(config, views, text);
   return result;
 }
 
@@ -322,6 +408,10 @@ void register_bench(CLI::App& app, Action& action) {
   cmd->add_option("--threads", options->threads,
                   "Threads of the streaming decoder (bands of output lines; default: the machine's hardware threads)")
       ->check(CLI::Range(1, kMaxDecoderThreads));
+  cmd->add_option("--format", options->formats,
+                  "A format of the fixed-point decoders, KNOB=VALUE with trm sweep's knobs (repeatable, e.g. "
+                  "--format linear_frac_bits=20 --format bilinear_weight_frac_bits=8); the run also checks DESIGN §6 "
+                  "against the reference at these formats");
   cmd->add_option("--only", options->only,
                   "Time only these contenders (repeatable) besides opencv-float32, the yardstick of every ratio")
       ->check(CLI::IsMember(kContenders));
@@ -343,13 +433,15 @@ void register_bench(CLI::App& app, Action& action) {
       }
       const std::vector<std::string> panels =
           o.panels.empty() ? std::vector<std::string>{"vive", "lcd"} : o.panels;
-      for (const std::string& panel : panels) parse_panel(panel);  // rejected before any work
+      for (const std::string& panel : panels) {  // rejected before any work
+        config_for(sizes.front(), panel, o.formats);
+      }
       double load[3] = {0.0, 0.0, 0.0};
       if (getloadavg(load, 3) != 3) load[0] = load[1] = load[2] = 0.0;
       Json report = {{"machine", {{"hardware_threads", std::thread::hardware_concurrency()},
                                   {"load_average_at_start", {load[0], load[1], load[2]}}}},
                      {"parameters", {{"reduction", 0.5}, {"scene", o.scene}, {"pairs", o.pairs},
-                                     {"repeats", o.repeats}, {"quick", o.quick}}}};
+                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats}}}};
       Json results = Json::array();
       std::cout << "trm bench: " << std::thread::hardware_concurrency() << " hardware threads, load average "
                 << load[0] << " at start; OpenCV threads " << cv::getNumThreads() << "\n";
