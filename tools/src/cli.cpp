@@ -2,6 +2,7 @@
 
 #include "trm/atomic_file.hpp"
 
+#include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
 

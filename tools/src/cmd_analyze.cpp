@@ -6,6 +6,7 @@
 #include "output_dir.hpp"
 #include "run_report.hpp"
 
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
 

@@ -15,6 +15,7 @@
 #include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
 
+#include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
 
 #include <algorithm>

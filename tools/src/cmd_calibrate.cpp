@@ -6,6 +6,7 @@
 
 #include "trm/plot.hpp"
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstdio>

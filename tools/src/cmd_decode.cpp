@@ -11,6 +11,7 @@
 
 #include "trm/link_simulation.hpp"
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <chrono>

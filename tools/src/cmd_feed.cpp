@@ -12,6 +12,7 @@
 
 #include "trm/atomic_file.hpp"
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>

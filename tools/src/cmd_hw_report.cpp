@@ -7,6 +7,7 @@
 #include "trm/atomic_file.hpp"
 #include "trm/decoder_json.hpp"
 
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
 #include <stdexcept>

@@ -9,6 +9,7 @@
 #include "trm/jpegls.hpp"
 #include "trm/scene.hpp"
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstdio>

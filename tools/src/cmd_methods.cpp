@@ -3,6 +3,7 @@
 
 #include "trm/display_method.hpp"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <iostream>
 

@@ -10,6 +10,7 @@
 
 #include "trm/transfer.hpp"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <iostream>
 #include <functional>

@@ -8,6 +8,7 @@
 #include "sweep_report.hpp"
 #include "sweep_shard.hpp"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <iomanip>
 #include <iostream>

@@ -8,6 +8,7 @@
 #include "trm/atomic_file.hpp"
 #include "trm/decoder_json.hpp"
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
 #include <memory>

@@ -2,14 +2,13 @@
 // one place: the scene or input, the encoder, the display method, the decoder and its fixed-point formats, the link.
 #pragma once
 
+#include "trm/cli.hpp"
 #include "trm/display_method.hpp"
 #include "trm/encoder.hpp"
 #include "trm/fixed_decoder.hpp"
 #include "trm/link_simulation.hpp"
 #include "trm/scene.hpp"
 #include "view_size.hpp"
-
-#include <CLI/CLI.hpp>
 
 #include <memory>
 #include <string>

@@ -3,9 +3,14 @@
 // returns the process exit code.
 #pragma once
 
-#include <CLI/CLI.hpp>
-
 #include <functional>
+
+// CLI11 is header-only and costs every translation unit that includes it seconds of code generation (its
+// validator objects are defined in each): only the files that build options include it.
+namespace CLI {
+class App;
+class Validator;
+}  // namespace CLI
 
 namespace trm::cli {
 
