@@ -198,17 +198,15 @@ cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, d
   return reduced;
 }
 
-cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height) {
+cv::Mat upsample_horizontal(const cv::Mat& reduced, int full_width) {
   if (reduced.depth() != CV_64F || reduced.empty()) throw std::invalid_argument("upsample: expected a non-empty CV_64F matrix");
   require_axis(full_width, reduced.cols, "upsample (width)");
-  require_axis(full_height, reduced.rows, "upsample (height)");
   const int channels = reduced.channels();
 
   std::vector<BilinearTap> col_taps(static_cast<std::size_t>(full_width));
   for (int x = 0; x < full_width; ++x) col_taps[static_cast<std::size_t>(x)] = bilinear_tap(x, full_width, reduced.cols);
 
-  // Horizontal pass on every reduced row (as OpenCV does), then a vertical blend of two such rows.
-  // Each pass's output rows on OpenCV's threads (every sample computed alone: the same doubles for any split).
+  // Output rows on OpenCV's threads (every sample computed alone: the same doubles for any split).
   cv::Mat horizontal(reduced.rows, full_width, reduced.type());
   cv::parallel_for_(cv::Range(0, reduced.rows), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y) {
@@ -222,17 +220,25 @@ cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height) {
       }
     }
   });
+  return horizontal;
+}
 
+void upsample_row(const cv::Mat& horizontal, int y, int full_height, double* out) {
+  const BilinearTap t = bilinear_tap(y, full_height, horizontal.rows);
+  const double* a = horizontal.ptr<double>(t.i0);
+  const double* b = horizontal.ptr<double>(t.i1);
+  const int row_len = horizontal.cols * horizontal.channels();
+  for (int i = 0; i < row_len; ++i) out[i] = (1.0 - t.frac) * a[i] + t.frac * b[i];
+}
+
+cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height) {
+  if (reduced.depth() != CV_64F || reduced.empty()) throw std::invalid_argument("upsample: expected a non-empty CV_64F matrix");
+  require_axis(full_width, reduced.cols, "upsample (width)");
+  require_axis(full_height, reduced.rows, "upsample (height)");
+  const cv::Mat horizontal = upsample_horizontal(reduced, full_width);
   cv::Mat full(full_height, full_width, reduced.type());
-  const int row_len = full_width * channels;
   cv::parallel_for_(cv::Range(0, full_height), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const BilinearTap t = bilinear_tap(y, full_height, reduced.rows);
-      const double* a = horizontal.ptr<double>(t.i0);
-      const double* b = horizontal.ptr<double>(t.i1);
-      double* dst = full.ptr<double>(y);
-      for (int i = 0; i < row_len; ++i) dst[i] = (1.0 - t.frac) * a[i] + t.frac * b[i];
-    }
+    for (int y = rows.start; y < rows.end; ++y) upsample_row(horizontal, y, full_height, full.ptr<double>(y));
   });
   return full;
 }

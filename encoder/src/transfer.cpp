@@ -80,7 +80,7 @@ cv::Mat to_encoded(const cv::Mat& linear, Transfer transfer) {
 cv::Mat quantise(const cv::Mat& values, int bits) {
   require_double(values, "quantise");
   require_bits(bits);
-  const double max_code = static_cast<double>((1 << bits) - 1);
+  const int max_code = (1 << bits) - 1;
   cv::Mat codes(values.size(), CV_MAKETYPE(CV_16U, values.channels()));
   const int row_len = values.cols * values.channels();
   for (int y = 0; y < values.rows; ++y) {
@@ -89,7 +89,7 @@ cv::Mat quantise(const cv::Mat& values, int bits) {
     for (int i = 0; i < row_len; ++i) {
       // NaN would survive the clamp and make the integer conversion undefined: reject it here.
       if (std::isnan(src[i])) throw std::invalid_argument("quantise: NaN value");
-      dst[i] = static_cast<std::uint16_t>(std::floor(clamp01(src[i]) * max_code + 0.5));
+      dst[i] = quantise(src[i], max_code);
     }
   }
   return codes;
@@ -131,7 +131,7 @@ cv::Mat dequantise(const cv::Mat& codes, int bits) {
         throw std::invalid_argument("dequantise: code " + std::to_string(src[i]) + " exceeds " +
                                     std::to_string(bits) + "-bit range");
       }
-      dst[i] = src[i] / max_code;
+      dst[i] = dequantise(src[i], static_cast<int>(max_code));
     }
   }
   return values;

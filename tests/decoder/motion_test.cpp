@@ -52,6 +52,11 @@ TEST(Motion, WeightFollowsEquations5And6AndVanishesWhereContentMoved) {
 
   const test::PairOracle o = test::full_frame_oracle(pair.full.codes, link);
   const cv::Mat alpha = test::oracle_upsampled_linear(pair.reduced.codes, o.full_linear.size(), link);
+  // The motion test reads L_t and alpha bit for bit as U and lin of the encoder's primitives give them (the
+  // reference keeps L_t from the full frame, where the design recomputes it from d_t).
+  EXPECT_EQ(max_abs_difference(r.stages->at(Stage::PreviousLowPass), o.low_linear), 0.0);
+  EXPECT_EQ(max_abs_difference(f.stages->at(Stage::LowPass), o.low_linear), 0.0);
+  EXPECT_EQ(max_abs_difference(r.stages->at(Stage::Alpha), alpha), 0.0);
   const cv::Mat c = oracle_contrast(o.low_linear, alpha);
   EXPECT_LE(max_abs_difference(r.stages->at(Stage::Contrast), c), 1e-15);
   cv::Mat w(c.size(), CV_64FC1);

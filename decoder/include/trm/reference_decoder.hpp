@@ -46,6 +46,9 @@ class ReferenceDecoder : public HeadsetDecoder {
     std::int64_t residual_index = 0;  // index t of the full frame the residual comes from
     cv::Mat residual;          // rho_t, full size, signed
     cv::Mat previous_low;      // d_t = Q_b(D(E_t)) codes, reduced size, for the motion test
+    cv::Mat previous_low_linear;  // L_t = lin(U(d_t)), full size: what the motion test recomputes from d_t
+    double residual_mean_abs = 0.0;  // of rho as kept (after the LCD shortfall)
+    double residual_max_abs = 0.0;
     cv::Mat previous_drive;    // LCD: v_{t-1} actually shown (quantised drive as a value in [0, 1])
     DecodedFrame last_output;  // what this eye showed last, held when a view is lost
     cv::Mat previous_wanted;   // LCD: x_{t-1}, what frame t-1 contributed in linear light: the wanted value,

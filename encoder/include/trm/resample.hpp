@@ -41,5 +41,10 @@ BilinearTap bilinear_tap(int x, int full, int reduced);
 cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, double sigma);
 // U: reduced (CV_64F, any channels) -> full size W x H.
 cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height);
+// U in two parts, for callers that consume it a row at a time: the horizontal pass of every reduced row (reduced
+// height x W), then output row y (of H) as the vertical blend of two of its rows, written to `out` (W x channels
+// doubles). upsample() is exactly these two.
+cv::Mat upsample_horizontal(const cv::Mat& reduced, int full_width);
+void upsample_row(const cv::Mat& horizontal, int y, int full_height, double* out);
 
 }  // namespace trm

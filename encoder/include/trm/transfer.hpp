@@ -3,6 +3,8 @@
 
 #include "trm/frame.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace trm {
@@ -15,6 +17,10 @@ cv::Mat to_encoded(const cv::Mat& linear, Transfer transfer);
 
 // q = floor(x * (2^bits - 1) + 0.5) after clamping x to [0, 1]; returns CV_16U with the same channels.
 cv::Mat quantise(const cv::Mat& values, int bits);
+// The same for one value not NaN, with max_code = 2^bits - 1 (inline: the reference decoder quantises every sample).
+inline std::uint16_t quantise(double value, int max_code) {
+  return static_cast<std::uint16_t>(std::floor(std::clamp(value, 0.0, 1.0) * max_code + 0.5));
+}
 // Q_b of the reduced frame (DESIGN §3 quantisation, deterministic at exact half-code ties). D of symmetric content
 // lands exactly on k + 1/2 codes (two codes averaged, a Nyquist checkerboard, an edge midway between two rows); D in
 // doubles lands within its rounding error of that half, on either side by floating-point noise, and floor(v + 1/2)
@@ -32,6 +38,8 @@ std::uint16_t quantise_reduced(double value, int bits);
 cv::Mat quantise_reduced(const cv::Mat& values, int bits);
 // code / (2^bits - 1), CV_64F.
 cv::Mat dequantise(const cv::Mat& codes, int bits);
+// The same for one code, with max_code = 2^bits - 1.
+inline double dequantise(std::uint16_t code, int max_code) { return code / static_cast<double>(max_code); }
 
 // Rec. 709 luma on linear RGB: Y = 0.2126 R + 0.7152 G + 0.0722 B (CV_64FC3 -> CV_64FC1).
 cv::Mat luma(const cv::Mat& linear_rgb);
