@@ -15,21 +15,21 @@ namespace {
 using perception_detail::number_text;
 using perception_detail::reject;
 
-constexpr const char* kWhere = "LcResponse";
+constexpr const char* kLcResponseName = "LcResponse";
 constexpr double kNeverRisesTauS = 1e30;
 constexpr int kMostNewtonSteps = 100;
 
 }  // namespace
 
 LcResponse::LcResponse(const LcResponseParams& params, double frame_period_s) : params_(params) {
-  perception_detail::require_positive(kWhere, "tau_off_s", params.tau_off_s);
+  perception_detail::require_positive(kLcResponseName, "tau_off_s", params.tau_off_s);
   if (!(std::isfinite(params.drive_ratio) && params.drive_ratio > 1.0)) {
-    reject(kWhere, "drive_ratio", "(V_max / V_th) must be finite and > 1, got " + number_text(params.drive_ratio));
+    reject(kLcResponseName, "drive_ratio", "(V_max / V_th) must be finite and > 1, got " + number_text(params.drive_ratio));
   }
   if (!(params.drive_gamma >= 0.5 && params.drive_gamma <= 4.0)) {
-    reject(kWhere, "drive_gamma", "must be in [0.5, 4], got " + number_text(params.drive_gamma));
+    reject(kLcResponseName, "drive_gamma", "must be in [0.5, 4], got " + number_text(params.drive_gamma));
   }
-  perception_detail::require_positive(kWhere, "frame_period_s", frame_period_s);
+  perception_detail::require_positive(kLcResponseName, "frame_period_s", frame_period_s);
   period_ = frame_period_s;
   fall_reach_ = -std::expm1(-period_ / params.tau_off_s);
 }

@@ -16,7 +16,7 @@ namespace {
 using perception_detail::number_text;
 using perception_detail::reject;
 
-constexpr const char* kWhere = "LcSecondOrder";
+constexpr const char* kLcSecondOrderName = "LcSecondOrder";
 
 // e^{−800} is below the smallest subnormal double (4.9e-324, e^{−744}) even times the critical mode's factor u:
 // past 800 / (slowest decay rate) natural times the state has reached the drive exactly in double precision, so
@@ -41,9 +41,9 @@ Eigen::Matrix2d integral_of_exponential(const Eigen::Matrix2d& b, double u) {
 }  // namespace
 
 LcSecondOrder::LcSecondOrder(const LcSecondOrderParams& params, double frame_period_s) : params_(params) {
-  perception_detail::require_positive(kWhere, "tau_s", params.tau_s);
-  perception_detail::require_positive(kWhere, "damping_ratio", params.damping_ratio);
-  perception_detail::require_positive(kWhere, "frame_period_s", frame_period_s);
+  perception_detail::require_positive(kLcSecondOrderName, "tau_s", params.tau_s);
+  perception_detail::require_positive(kLcSecondOrderName, "damping_ratio", params.damping_ratio);
+  perception_detail::require_positive(kLcSecondOrderName, "frame_period_s", frame_period_s);
   const double zeta = params.damping_ratio;
   // The slowest mode decays at ζ (ζ < 1) or ζ − √(ζ² − 1) = 1 / (ζ + √(ζ² − 1)) (ζ >= 1) per natural time.
   const double slowest = zeta < 1.0 ? zeta : 1.0 / (zeta + std::sqrt((zeta - 1.0) * (zeta + 1.0)));

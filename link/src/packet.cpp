@@ -34,8 +34,6 @@ constexpr std::size_t kOffSequence = 40;
 static_assert(kOffSequence + 4 == kPacketHeaderBytes);
 
 constexpr std::uint8_t kFlagReduced = 0x01;
-constexpr int kMaxDimension = 0xFFFF;  // 16-bit size fields
-
 bool fits_u16(int v) { return v >= 0 && v <= kMaxDimension; }
 
 }  // namespace

@@ -11,8 +11,6 @@ namespace trm::link {
 
 namespace {
 
-constexpr int kMaxDimension = 0xFFFF;  // 16-bit size fields of the packet header
-
 // The rectangles a view is cut into, in transmission order (docs/link.md, "Packetisation").
 std::vector<cv::Rect> plan_rectangles(int width, int height, int bits, const PacketizerConfig& config) {
   std::vector<cv::Rect> rects;

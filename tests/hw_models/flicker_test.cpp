@@ -4,6 +4,8 @@
 // image has no temporal aliases, an edge held for two frames has more than one moving every frame.
 #include <gtest/gtest.h>
 
+#include "hw_models_test_support.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -16,7 +18,8 @@
 namespace trm {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test::kPi;
+
 
 // A view whose two frames carry a grating of `cycles` periods across `cols` in opposite phase, so the alternation
 // contrast (Y_a - Y_b) / (Y_a + Y_b) is exactly c cos(2 pi cycles x / cols).

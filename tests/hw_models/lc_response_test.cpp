@@ -1,6 +1,8 @@
 // The level-dependent liquid-crystal response (lc_response.hpp) and its use by PanelLight and the retina.
 #include <gtest/gtest.h>
 
+#include "hw_models_test_support.hpp"
+
 #include "trm/lc_response.hpp"
 #include "trm/panel.hpp"
 #include "trm/panel_light.hpp"
@@ -20,6 +22,8 @@
 
 namespace trm {
 namespace {
+
+using test::expect_invalid;
 
 constexpr double kRefresh = 120.0;
 constexpr double kPeriod = 1.0 / kRefresh;
@@ -62,15 +66,6 @@ double euler_frame(const LcResponseParams& p, double x0, double drive, double h,
   double x = x0;
   for (int i = 0; i < steps; ++i) x += h * rhs(p, x0, drive, x);
   return x;
-}
-
-void expect_invalid(const std::function<void()>& make, const std::string& needle) {
-  try {
-    make();
-    ADD_FAILURE() << "no exception, expected one naming " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
 }
 
 TEST(LcResponse, RisingAndFallingTransitionsAreTheirClosedForms) {

@@ -3,6 +3,8 @@
 // retina.
 #include <gtest/gtest.h>
 
+#include "hw_models_test_support.hpp"
+
 #include "trm/lc_second_order.hpp"
 #include "trm/panel_light.hpp"
 #include "trm/retina.hpp"
@@ -20,6 +22,8 @@
 
 namespace trm {
 namespace {
+
+using test::expect_invalid;
 
 using Real = long double;
 
@@ -62,16 +66,7 @@ Analytic analytic(Real tau, Real zeta, Real a, Real b, Real t) {
   return out;
 }
 
-void expect_invalid(const std::function<void()>& make, const std::string& needle) {
-  try {
-    make();
-    ADD_FAILURE() << "no exception, expected one naming " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
-
-constexpr double kPeriod = 1.0 / 90.0;
+constexpr double kPeriod90Hz = 1.0 / 90.0;
 
 TEST(LcSecondOrder, MatchesTheAnalyticSolutionForStepsFromAThousandthToAMillionNaturalTimes) {
   // The state after one frame and the light over it, in all three regimes, for dt/τ from 1e-3 to 1e6 and starts at
@@ -84,19 +79,19 @@ TEST(LcSecondOrder, MatchesTheAnalyticSolutionForStepsFromAThousandthToAMillionN
   for (const double zeta : {0.2, 1.0, 5.0}) {
     for (int decade = -3; decade <= 6; ++decade) {
       const double dt_over_tau = std::pow(10.0, decade);
-      const double tau = kPeriod / dt_over_tau;
-      const LcSecondOrder lc({tau, zeta}, kPeriod);
+      const double tau = kPeriod90Hz / dt_over_tau;
+      const LcSecondOrder lc({tau, zeta}, kPeriod90Hz);
       for (const double drive : {0.0, 1.0, 0.45}) {
         for (const Start& s : starts) {
           const LcMotion start{s.level, s.rate_times_tau / tau};
-          const Analytic exact = analytic(tau, zeta, Real(s.level) - drive, Real(start.rate_per_s), kPeriod);
+          const Analytic exact = analytic(tau, zeta, Real(s.level) - drive, Real(start.rate_per_s), kPeriod90Hz);
           const LcMotion end = lc.end_of_frame(start, drive);
-          const LcMotion advanced = lc.advance(start, drive, kPeriod);
+          const LcMotion advanced = lc.advance(start, drive, kPeriod90Hz);
           const double level_error = std::abs(end.level - static_cast<double>(drive + exact.deviation));
           const double rate_error = std::abs(end.rate_per_s - static_cast<double>(exact.rate)) * tau;
           const double integral_error =
-              std::abs(lc.integral(start, drive, 0.0, kPeriod) - static_cast<double>(drive * Real(kPeriod) +
-                                                                                      exact.integral)) / kPeriod;
+              std::abs(lc.integral(start, drive, 0.0, kPeriod90Hz) - static_cast<double>(drive * Real(kPeriod90Hz) +
+                                                                                      exact.integral)) / kPeriod90Hz;
           SCOPED_TRACE(testing::Message() << "zeta " << zeta << " dt/tau " << dt_over_tau << " drive " << drive
                                           << " from " << s.level << ", " << s.rate_times_tau);
           EXPECT_LT(level_error, 1e-14);
@@ -118,33 +113,33 @@ TEST(LcSecondOrder, MatchesTheAnalyticSolutionForStepsFromAThousandthToAMillionN
 TEST(LcSecondOrder, PartialIntegralsAddUpAndMatchTheClosedForm) {
   // ∫_{t0}^{t1} from the weights against the difference of the closed-form integrals, for windows inside the frame.
   const double tau = 0.0021, zeta = 0.35;
-  const LcSecondOrder lc({tau, zeta}, kPeriod);
+  const LcSecondOrder lc({tau, zeta}, kPeriod90Hz);
   const LcMotion start{0.2, 40.0};
   const double drive = 0.8;
-  for (const auto& [t0, t1] : {std::pair{0.0, 0.001}, std::pair{0.002, 0.0071}, std::pair{0.0105, kPeriod}}) {
+  for (const auto& [t0, t1] : {std::pair{0.0, 0.001}, std::pair{0.002, 0.0071}, std::pair{0.0105, kPeriod90Hz}}) {
     const Real exact = drive * Real(t1 - t0) + analytic(tau, zeta, Real(start.level) - drive, start.rate_per_s, t1).integral -
                        analytic(tau, zeta, Real(start.level) - drive, start.rate_per_s, t0).integral;
     EXPECT_NEAR(lc.integral(start, drive, t0, t1), static_cast<double>(exact), 1e-15) << t0 << " " << t1;
   }
   double sum = 0.0;
-  for (int k = 0; k < 7; ++k) sum += lc.integral(start, drive, kPeriod * k / 7, kPeriod * (k + 1) / 7);
-  EXPECT_NEAR(sum, lc.integral(start, drive, 0.0, kPeriod), 1e-17);
+  for (int k = 0; k < 7; ++k) sum += lc.integral(start, drive, kPeriod90Hz * k / 7, kPeriod90Hz * (k + 1) / 7);
+  EXPECT_NEAR(sum, lc.integral(start, drive, 0.0, kPeriod90Hz), 1e-17);
 }
 
 TEST(LcSecondOrder, UnderdampedStepOvershootsByTheTextbookFraction) {
   // A unit step from rest peaks at t = π τ / √(1 − ζ²) at 1 + e^{−πζ/√(1−ζ²)}; ζ >= 1 never passes the drive.
   for (const double zeta : {0.1, 0.5, 0.9}) {
     const double tau = 0.001;
-    const LcSecondOrder lc({tau, zeta}, kPeriod);
+    const LcSecondOrder lc({tau, zeta}, kPeriod90Hz);
     const double root = std::sqrt(1.0 - zeta * zeta);
     const LcMotion peak = lc.advance({0.0, 0.0}, 1.0, M_PI * tau / root);
     EXPECT_NEAR(peak.level, 1.0 + std::exp(-M_PI * zeta / root), 1e-13) << zeta;
     EXPECT_NEAR(peak.rate_per_s * tau, 0.0, 1e-12) << zeta;
   }
   for (const double zeta : {1.0, 1.5, 20.0}) {
-    const LcSecondOrder lc({0.001, zeta}, kPeriod);
+    const LcSecondOrder lc({0.001, zeta}, kPeriod90Hz);
     for (int i = 0; i <= 200; ++i) {
-      const double level = lc.advance({0.0, 0.0}, 1.0, kPeriod * i / 200.0).level;
+      const double level = lc.advance({0.0, 0.0}, 1.0, kPeriod90Hz * i / 200.0).level;
       EXPECT_GE(level, 0.0);
       EXPECT_LE(level, 1.0);
     }
@@ -159,8 +154,8 @@ TEST(LcSecondOrder, DampedCrystalStaysWithinTheDriveRangeWhereExplicitEulerDiver
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (const double zeta : {1.0, 3.0}) {
     for (const double dt_over_tau : {1e-3, 0.5, 10.0, 1e3, 1e6}) {
-      const double tau = kPeriod / dt_over_tau;
-      const LcSecondOrder lc({tau, zeta}, kPeriod);
+      const double tau = kPeriod90Hz / dt_over_tau;
+      const LcSecondOrder lc({tau, zeta}, kPeriod90Hz);
       LcMotion exact{0.5, 0.0};
       double euler_x = 0.5, euler_v = 0.0;
       bool euler_diverged = false;
@@ -171,8 +166,8 @@ TEST(LcSecondOrder, DampedCrystalStaysWithinTheDriveRangeWhereExplicitEulerDiver
         ASSERT_LE(exact.level, 1.0 + 1e-15) << zeta << " " << dt_over_tau << " frame " << f;
         // x'' = (p − x − k x') / m.
         const double accel = (drive - euler_x - 2.0 * zeta * tau * euler_v) / (tau * tau);
-        euler_x += kPeriod * euler_v;
-        euler_v += kPeriod * accel;
+        euler_x += kPeriod90Hz * euler_v;
+        euler_v += kPeriod90Hz * accel;
         euler_diverged = euler_diverged || !(std::abs(euler_x) < 1e6);
       }
       if (dt_over_tau >= 10.0) {
@@ -193,10 +188,10 @@ TEST(LcSecondOrder, PanelLightUsesItsStateAndRateAndTheRetinaAveragesIt) {
   const double tau = 0.0015;
   // Critical damping: the frame's end and its light are the closed form.
   const LcMotion start{0.1, 120.0};
-  const Analytic exact = analytic(tau, 1.0L, Real(0.1) - 0.8, 120.0L, kPeriod);
+  const Analytic exact = analytic(tau, 1.0L, Real(0.1) - 0.8, 120.0L, kPeriod90Hz);
   const LcMotion end = light.end_state(start, 0.8);
   EXPECT_NEAR(end.level, static_cast<double>(0.8L + exact.deviation), 1e-14);
-  EXPECT_NEAR(light.integral(0.0, kPeriod, start, 0.8), static_cast<double>(0.8L * kPeriod + exact.integral), 1e-16);
+  EXPECT_NEAR(light.integral(0.0, kPeriod90Hz, start, 0.8), static_cast<double>(0.8L * kPeriod90Hz + exact.integral), 1e-16);
   EXPECT_NEAR(light.level_at(0.004, start, 0.8),
               static_cast<double>(0.8L + analytic(tau, 1.0L, Real(0.1) - 0.8, 120.0L, 0.004).deviation), 1e-14);
   EXPECT_THROW(light.end_state(0.1, 0.8), std::logic_error);
@@ -210,15 +205,15 @@ TEST(LcSecondOrder, PanelLightUsesItsStateAndRateAndTheRetinaAveragesIt) {
     Real x = levels[0][i], v = 0.0L, sum = 0.0L;
     for (int n = 0; n < 5; ++n) {
       const Real drive = levels[n][i];
-      const Analytic a = analytic(tau, 1.0L, x - drive, v, kPeriod);
-      sum += drive * Real(kPeriod) + a.integral;
+      const Analytic a = analytic(tau, 1.0L, x - drive, v, kPeriod90Hz);
+      sum += drive * Real(kPeriod90Hz) + a.integral;
       x = drive + a.deviation;
       v = a.rate;
     }
     RetinaOptions options;
     options.substeps = 5;
     const cv::Mat seen = retinal_row(frames, light, custom_viewer(11.42), 0.0, options);
-    EXPECT_NEAR(seen.at<double>(0, i), static_cast<double>(sum / (5 * Real(kPeriod))), 1e-14) << i;
+    EXPECT_NEAR(seen.at<double>(0, i), static_cast<double>(sum / (5 * Real(kPeriod90Hz))), 1e-14) << i;
   }
 }
 
@@ -240,7 +235,7 @@ TEST(LcSecondOrder, OverdriveEndsTheFrameAtTheTargetFromTheLevelAndTheRateOrClam
     int reached = 0, clamped = 0;
     for (double level : targets) {
       const double drive = light.drive(state, level);
-      const auto end_at = [&](Real p) { return p + analytic(tau, zeta, state.level - p, state.rate_per_s, kPeriod).deviation; };
+      const auto end_at = [&](Real p) { return p + analytic(tau, zeta, state.level - p, state.rate_per_s, kPeriod90Hz).deviation; };
       if (drive > 0.0 && drive < 1.0) {
         EXPECT_NEAR(static_cast<double>(end_at(drive)), level, 1e-12) << "from " << state.level << " to " << level;
         ++reached;
@@ -257,9 +252,9 @@ TEST(LcSecondOrder, OverdriveEndsTheFrameAtTheTargetFromTheLevelAndTheRateOrClam
       const LcMotion next = light.end_state(state, level);
       EXPECT_NEAR(next.level, static_cast<double>(end_at(drive)), 1e-13);
       // The light of the frame is the closed form's at that drive too, and stays within the drive range.
-      EXPECT_NEAR(light.integral(0.0, kPeriod, state, level),
-                  static_cast<double>(Real(drive) * Real(kPeriod) +
-                                      analytic(tau, zeta, state.level - drive, state.rate_per_s, kPeriod).integral),
+      EXPECT_NEAR(light.integral(0.0, kPeriod90Hz, state, level),
+                  static_cast<double>(Real(drive) * Real(kPeriod90Hz) +
+                                      analytic(tau, zeta, state.level - drive, state.rate_per_s, kPeriod90Hz).integral),
                   1e-15);
       EXPECT_GE(next.level, -1e-12);
       EXPECT_LE(next.level, 1.0 + 1e-12);
@@ -294,22 +289,22 @@ TEST(LcSecondOrder, OverdrivenLightThroughTheRetinaCarriesTheDrive) {
     LcMotion state{0.4, previous_rate.at<cv::Vec3d>(0, 0)[c]};
     double sum = 0.0;
     for (int n = 0; n < 4; ++n) {
-      sum += light.integral(0.0, kPeriod, state, levels[n][c]);
+      sum += light.integral(0.0, kPeriod90Hz, state, levels[n][c]);
       state = light.end_state(state, levels[n][c]);
     }
-    EXPECT_NEAR(seen.at<cv::Vec3d>(0, 0)[c], sum / (4 * kPeriod), 1e-13) << c;
+    EXPECT_NEAR(seen.at<cv::Vec3d>(0, 0)[c], sum / (4 * kPeriod90Hz), 1e-13) << c;
   }
   expect_invalid([&] { retinal_image(images, light, custom_viewer(11.42), 0.0, options, {}, previous_rate); },
                  "'previous_rate'");
 }
 
 TEST(LcSecondOrder, BadParametersAreRejectedByName) {
-  expect_invalid([] { LcSecondOrder({0.0, 1.0}, kPeriod); }, "'tau_s'");
-  expect_invalid([] { LcSecondOrder({std::nan(""), 1.0}, kPeriod); }, "'tau_s'");
-  expect_invalid([] { LcSecondOrder({0.001, 0.0}, kPeriod); }, "'damping_ratio'");
-  expect_invalid([] { LcSecondOrder({0.001, INFINITY}, kPeriod); }, "'damping_ratio'");
+  expect_invalid([] { LcSecondOrder({0.0, 1.0}, kPeriod90Hz); }, "'tau_s'");
+  expect_invalid([] { LcSecondOrder({std::nan(""), 1.0}, kPeriod90Hz); }, "'tau_s'");
+  expect_invalid([] { LcSecondOrder({0.001, 0.0}, kPeriod90Hz); }, "'damping_ratio'");
+  expect_invalid([] { LcSecondOrder({0.001, INFINITY}, kPeriod90Hz); }, "'damping_ratio'");
   expect_invalid([] { LcSecondOrder({0.001, 1.0}, 0.0); }, "'frame_period_s'");
-  const LcSecondOrder lc({0.001, 1.0}, kPeriod);
+  const LcSecondOrder lc({0.001, 1.0}, kPeriod90Hz);
   expect_invalid([&] { lc.weights(-1.0, 0.0); }, "'t0'");
   expect_invalid([&] { lc.weights(0.002, 0.001); }, "'t1'");
   expect_invalid([&] { lc.advance({}, 0.0, -1.0); }, "'seconds'");

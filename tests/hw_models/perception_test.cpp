@@ -3,6 +3,8 @@
 // oracle computed here by another route.
 #include <gtest/gtest.h>
 
+#include "hw_models_test_support.hpp"
+
 #include <cmath>
 #include <complex>
 #include <functional>
@@ -21,18 +23,11 @@
 namespace trm {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::expect_invalid;
+using test::kPi;
+using test::kNaN;
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "no exception; expected one naming " << needle;
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find(needle), std::string::npos) << error.what();
-  }
-}
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // ---- Smooth pursuit (Eq. 3) ----
 

@@ -3,6 +3,8 @@
 // integral is its closed form, and the sub-stepped integral converges at the order its error analysis predicts.
 #include <gtest/gtest.h>
 
+#include "hw_models_test_support.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -21,16 +23,9 @@
 namespace trm {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using test::expect_invalid;
+using test::kNaN;
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "no exception; expected one naming " << needle;
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find(needle), std::string::npos) << error.what();
-  }
-}
 
 PanelLight oled_light(double refresh_hz, double duty, ScanOut scan = ScanOut::Global) {
   return PanelLight({refresh_hz, duty, 0.0, 0.0, scan});

@@ -13,11 +13,7 @@
 namespace trm::link {
 namespace {
 
-std::filesystem::path out_dir() {
-  const std::filesystem::path dir = std::filesystem::path(TRM_BINARY_DIR) / "test_link_out";
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+using test_support::out_dir;
 
 std::vector<std::vector<std::uint8_t>> sample_packets() {
   Transmitter tx;

@@ -10,14 +10,10 @@
 namespace trm::link {
 namespace {
 
+using test_support::out_dir;
+
 using test_support::make_view;
 using test_support::same_codes;
-
-std::filesystem::path out_dir() {
-  const std::filesystem::path dir = std::filesystem::path(TRM_BINARY_DIR) / "test_link_out";
-  std::filesystem::create_directories(dir);
-  return dir;
-}
 
 TEST(LinkSimulation, CarriesAccountsRecordsAndReplays) {
   const auto capture = out_dir() / "simulation.trmcap";

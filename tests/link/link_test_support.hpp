@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <filesystem>
 
 namespace trm::link::test_support {
 
@@ -53,6 +54,13 @@ inline LinkFrame make_view(std::int64_t t, int eye, int full_width, int full_hei
 
 inline bool same_codes(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+// The tests' output directory under the build tree, created on first use.
+inline std::filesystem::path out_dir() {
+  const std::filesystem::path dir = std::filesystem::path(TRM_BINARY_DIR) / "test_link_out";
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 }  // namespace trm::link::test_support

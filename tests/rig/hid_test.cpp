@@ -195,12 +195,12 @@ TEST(Hid, SilentRigTimesOut) {
   EXPECT_EQ(stats.frames_sent, 0);
 }
 
-struct FaultCase {
+struct HidFaultCase {
   Fault fault;
   RigErrorKind expected;
 };
 
-class HidFault : public ::testing::TestWithParam<FaultCase> {};
+class HidFault : public ::testing::TestWithParam<HidFaultCase> {};
 
 TEST_P(HidFault, MidFrameFaultGivesTheDocumentedErrorAndKeepsTheTally) {
   HidRigConfig config = rig_config();
@@ -230,8 +230,8 @@ TEST_P(HidFault, MidFrameFaultGivesTheDocumentedErrorAndKeepsTheTally) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Faults, HidFault,
-                         ::testing::Values(FaultCase{Fault::Stall, RigErrorKind::Stalled},
-                                           FaultCase{Fault::Vanish, RigErrorKind::Disconnected}),
+                         ::testing::Values(HidFaultCase{Fault::Stall, RigErrorKind::Stalled},
+                                           HidFaultCase{Fault::Vanish, RigErrorKind::Disconnected}),
                          [](const auto& info) { return std::string(info.param.fault == Fault::Stall ? "Stall" : "Unplug"); });
 
 TEST(HidOpen, NoDeviceNamesTheVidPid) {

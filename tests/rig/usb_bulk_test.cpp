@@ -180,13 +180,13 @@ TEST(UsbBulk, SilentRigTimesOut) {
   EXPECT_EQ(stats.interrupted_frame, 0);
 }
 
-struct FaultCase {
+struct UsbFaultCase {
   Fault fault;
   RigErrorKind expected;
   const char* words;
 };
 
-class UsbBulkFault : public ::testing::TestWithParam<FaultCase> {};
+class UsbBulkFault : public ::testing::TestWithParam<UsbFaultCase> {};
 
 TEST_P(UsbBulkFault, MidFrameFaultGivesTheDocumentedErrorAndKeepsTheTally) {
   RigBehaviour rig;
@@ -221,9 +221,9 @@ TEST_P(UsbBulkFault, MidFrameFaultGivesTheDocumentedErrorAndKeepsTheTally) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Faults, UsbBulkFault,
-                         ::testing::Values(FaultCase{Fault::Stall, RigErrorKind::Stalled, "stalled"},
-                                           FaultCase{Fault::Vanish, RigErrorKind::Disconnected, "disappeared"},
-                                           FaultCase{Fault::Hang, RigErrorKind::Timeout, "stopped accepting data"}),
+                         ::testing::Values(UsbFaultCase{Fault::Stall, RigErrorKind::Stalled, "stalled"},
+                                           UsbFaultCase{Fault::Vanish, RigErrorKind::Disconnected, "disappeared"},
+                                           UsbFaultCase{Fault::Hang, RigErrorKind::Timeout, "stopped accepting data"}),
                          [](const auto& info) {
                            return std::string(info.param.fault == Fault::Stall ? "Stall" : info.param.fault == Fault::Vanish ? "Unplug" : "Hang");
                          });

@@ -18,9 +18,9 @@ namespace {
 
 using trm::test::run_trm;
 
-class TempDir : public trm::test::ScratchDir {
+class AnalyzeTempDir : public trm::test::ScratchDir {
  public:
-  TempDir() : ScratchDir("trm-analyze-") {}
+  AnalyzeTempDir() : ScratchDir("trm-analyze-") {}
 };
 
 // A CSV file as a header and rows of named cells.
@@ -58,7 +58,7 @@ double number(const std::map<std::string, std::string>& row, const std::string& 
 // The quick grid: 1 speed (10 deg/s), 2 values of each parameter, r in {1, 0.7, 0.5, 0.3, 0.1}; discs at 100 and
 // 165 Hz; cycles 1 + 1 and 1 + 2.
 TEST(Analyze, QuickRunWritesEveryTableAndTheEnergyRisesWithPixelsSaved) {
-  TempDir tmp;
+  AnalyzeTempDir tmp;
   const auto run = run_trm("analyze --quick --out " + tmp.str("a"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   for (const char* name : {"analyze.md", "study.csv", "experiment1.csv", "cycles.csv", "study_contrast.png",
@@ -123,7 +123,7 @@ TEST(Analyze, QuickRunWritesEveryTableAndTheEnergyRisesWithPixelsSaved) {
 }
 
 TEST(Analyze, BadInputGivesOneMessageAndNoOutput) {
-  TempDir tmp;
+  AnalyzeTempDir tmp;
   const std::vector<std::pair<std::string, std::string>> cases{
       {"--ppd 0", "--ppd"},
       {"--ppds 30,-1", "--ppds"},

@@ -35,9 +35,9 @@ namespace {
 using trm::test::run_trm;
 using trm::test::TrmResult;
 
-class TempDir : public trm::test::ScratchDir {
+class SafeWritesTempDir : public trm::test::ScratchDir {
  public:
-  TempDir() : ScratchDir("trm-safe-") {}
+  SafeWritesTempDir() : ScratchDir("trm-safe-") {}
 };
 
 // Every entry under dir (not following links): relative name -> type and, for files, the content.
@@ -81,7 +81,7 @@ void expect_one_error(const TrmResult& r, const std::string& needle, const std::
 const std::string kSmall = " --scene discs --size 16x12 --frames 2";
 
 TEST(SafeWrites, FileOutputsRefuseDevicesFifosSymlinksAndDirectories) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   const fs::path fifo = tmp.path() / "fifo", node = tmp.path() / "null", link = tmp.path() / "link.json",
                  real = tmp.path() / "real.json", dir = tmp.path() / "dir";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
@@ -113,7 +113,7 @@ TEST(SafeWrites, FileOutputsRefuseDevicesFifosSymlinksAndDirectories) {
 }
 
 TEST(SafeWrites, OutDirIsReplacedOnlyIfTrmWroteEverythingInIt) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   // A project that happens to hold a report.json is not a trm output.
   fs::create_directories(tmp.path() / "project");
   write_text(tmp.path() / "project" / "report.json", "{\"mine\": true}\n");
@@ -152,7 +152,7 @@ TEST(SafeWrites, OutDirIsReplacedOnlyIfTrmWroteEverythingInIt) {
 }
 
 TEST(SafeWrites, FeedSummaryInAMissingDirectoryIsAnErrorAndWritesNothing) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   const std::string summary = tmp.str("missing/s.json");
   const TrmResult r = run_trm("feed" + kSmall + " --fps 0 --file " + tmp.str("rig.bin") + " --summary " + summary);
   expect_one_error(r, summary, "feed --summary missing/s.json");
@@ -160,7 +160,7 @@ TEST(SafeWrites, FeedSummaryInAMissingDirectoryIsAnErrorAndWritesNothing) {
 }
 
 TEST(SafeWrites, FileOutputsAtAnExistingDirectoryLeaveNoTemporary) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   fs::create_directories(tmp.path() / "d");
   const auto before = snapshot(tmp.path());
   for (const std::string& command : {"hw-report --size 16x12 --json " + tmp.str("d"), "vectors --update-golden " + tmp.str("d")}) {
@@ -170,7 +170,7 @@ TEST(SafeWrites, FileOutputsAtAnExistingDirectoryLeaveNoTemporary) {
 }
 
 TEST(SafeWrites, FeedFileIsNotCreatedWhenTheArgumentsOrTheFeedFail) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   const std::string file = tmp.str("rig.bin");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"feed" + kSmall + " --fps nan --file " + file, "fps"},
@@ -187,7 +187,7 @@ TEST(SafeWrites, FeedFileIsNotCreatedWhenTheArgumentsOrTheFeedFail) {
 }
 
 TEST(SafeWrites, VectorsUpdateGoldenWithOutIsAnError) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   const TrmResult r = run_trm("vectors --update-golden " + tmp.str("g.txt") + " --out " + tmp.str("v"));
   expect_one_error(r, "--out", "vectors --update-golden --out");
   EXPECT_TRUE(fs::is_empty(tmp.path()));
@@ -211,7 +211,7 @@ class FullDisk {
 };
 
 TEST(SafeWrites, AFullDiskNamesTheTargetAndTheReasonAndLeavesNothing) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   FullDisk disk(tmp.path() / "disk");
   if (!disk.mounted()) GTEST_SKIP() << "cannot mount a small tmpfs here (needs root)";
   const fs::path d = tmp.path() / "disk";
@@ -287,7 +287,7 @@ int wait_for(pid_t pid, double seconds) {
 
 TEST(SafeWrites, SignalsDuringARunRemoveItsStagingEntries) {
   for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
-    TempDir tmp, logs;
+    SafeWritesTempDir tmp, logs;
     const fs::path work = tmp.path();
     write_text(work / "keep.txt", "unrelated");
     const auto before = snapshot(work);
@@ -311,7 +311,7 @@ TEST(SafeWrites, SignalsDuringARunRemoveItsStagingEntries) {
 }
 
 TEST(SafeWrites, StaleStagingEntriesOfDeadProcessesAreRemoved) {
-  TempDir tmp;
+  SafeWritesTempDir tmp;
   const fs::path work = tmp.path();
   const pid_t dead = ::fork();
   if (dead == 0) ::_exit(0);

@@ -26,9 +26,9 @@ using Result = trm::test::TrmResult;
 using trm::test::run_trm;
 
 // A scratch directory for one test, removed afterwards.
-class TempDir : public trm::test::ScratchDir {
+class CliTempDir : public trm::test::ScratchDir {
  public:
-  TempDir() : ScratchDir("trm-cli-") {}
+  CliTempDir() : ScratchDir("trm-cli-") {}
 };
 
 // Writes n random 8-bit sRGB frames (RGB noise, deterministic) as frame_000.png ...
@@ -105,7 +105,7 @@ TEST(Cli, UnknownSubcommandOrOptionFails) {
 }
 
 TEST(Cli, DecodeWritesDriveFramesAtBothDepths) {
-  TempDir tmp;
+  CliTempDir tmp;
   write_frames(tmp.path() / "in", 4, 17, 11);
   const Result r8 = run_trm("decode --input '" + tmp.str("in/frame_*.png") + "' --out " + tmp.str("out8"));
   ASSERT_EQ(r8.exit_code, 0) << r8.output;
@@ -142,7 +142,7 @@ TEST(Cli, DecodeWritesDriveFramesAtBothDepths) {
 }
 
 TEST(Cli, DecodeBadInputsFailCleanlyWithoutPartialOutput) {
-  TempDir tmp;
+  CliTempDir tmp;
   write_frames(tmp.path() / "in", 2, 8, 6);
   const std::string input = " --input '" + tmp.str("in/frame_*.png") + "'";
   struct Case {
@@ -181,7 +181,7 @@ TEST(Cli, DecodeBadInputsFailCleanlyWithoutPartialOutput) {
 }
 
 TEST(Cli, RunRefusesToReplaceAForeignDirectory) {
-  TempDir tmp;
+  CliTempDir tmp;
   fs::create_directories(tmp.path() / "precious");
   { std::ofstream(tmp.path() / "precious" / "thesis.tex") << "do not delete"; }
   const Result r = run_trm("run --frames 2 --size 16x12 --out " + tmp.str("precious"));
@@ -191,7 +191,7 @@ TEST(Cli, RunRefusesToReplaceAForeignDirectory) {
 }
 
 TEST(Cli, RunWritesReportAndPreviews) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result r = run_trm("run --scene discs --frames 4 --size 48x40 --out " + tmp.str("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(tmp.path() / "out" / "report.json");
@@ -249,14 +249,14 @@ TEST(Cli, RunWritesReportAndPreviews) {
 }
 
 TEST(Cli, LowRefreshWarnsButRuns) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result r = run_trm("run --frames 2 --size 16x12 --refresh 60 --out " + tmp.str("out"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("flicker"), std::string::npos);
 }
 
 TEST(Cli, LosslessCurveFallsWithTheReduction) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result r = run_trm("lossless --scene panorama --size 96x80 --frames 4 --reduction 1 0.5 0.25 --out " +
                            tmp.str("ll"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -276,7 +276,7 @@ TEST(Cli, LosslessCurveFallsWithTheReduction) {
 }
 
 TEST(Cli, RunHoldsTheFixedPointDecoderToTheReference) {
-  TempDir tmp;
+  CliTempDir tmp;
   // A fault-free link changes nothing but records the stream, so the same views can be decoded again apart.
   const Result r = run_trm("run --scene panorama --frames 4 --size 64x48 --link dp1.4 --out " + tmp.str("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -304,7 +304,7 @@ TEST(Cli, RunHoldsTheFixedPointDecoderToTheReference) {
 }
 
 TEST(Cli, DecodeWithEveryImplementationAgrees) {
-  TempDir tmp;
+  CliTempDir tmp;
   write_frames(tmp.path() / "in", 4, 33, 21);
   const std::string input = "decode --input '" + tmp.str("in/frame_*.png") + "' --out ";
   for (const char* impl : {"reference", "fixed", "fixed-frame"}) {
@@ -324,7 +324,7 @@ TEST(Cli, DecodeWithEveryImplementationAgrees) {
 TEST(Cli, RunWithLinkFaultsDecodesWithTheFixedPointModel) {
   // Faults no longer switch the decoder: the fixed-point model conceals lost lines itself, the reference runs beside
   // it on the same damaged views, and the comparison is reported as on a clean link.
-  TempDir tmp;
+  CliTempDir tmp;
   const Result r = run_trm("run --frames 6 --size 48x32 --ber 2e-4 --drop 0.02 --seed 5 --impl fixed --out " +
                            tmp.str("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -362,7 +362,7 @@ TEST(Cli, RunWithLinkFaultsDecodesWithTheFixedPointModel) {
 }
 
 TEST(Cli, CaptureReplaysIntoDecodeAndFeed) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result run = run_trm("run --frames 4 --size 32x24 --link dp1.2 --ber 1e-5 --seed 3 --out " + tmp.str("run"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   ASSERT_TRUE(fs::exists(tmp.path() / "run" / "link.trmcap"));
@@ -392,7 +392,7 @@ TEST(Cli, CaptureReplaysIntoDecodeAndFeed) {
 
 // Every display method goes over the same link, faults included, and says what it rendered and sent.
 TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFrame) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result list = run_trm("methods");
   ASSERT_EQ(list.exit_code, 0) << list.output;
   const std::vector<std::pair<std::string, double>> methods = {
@@ -429,7 +429,7 @@ TEST(Cli, EveryMethodRunsOverAFaultyLinkAndReportsItsPixelsAndPayloadPerLinkFram
 
 // A capture records its method; replay tells slots the method never sent from views the link lost.
 TEST(Cli, CaptureOfAHalfRateRunReplaysWithItsUnsentSlots) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result run = run_trm("run --method half-rate --frames 6 --size 32x24 --link dp1.2 --out " + tmp.str("run"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const Result decode = run_trm("decode --capture " + tmp.str("run/link.trmcap") + " --out " + tmp.str("dec"));
@@ -459,7 +459,7 @@ TEST(Cli, CaptureOfAHalfRateRunReplaysWithItsUnsentSlots) {
 TEST(Cli, CompareShowsNcsfiGhostingGrowWithSpeed) {
   // NCSFI's blurred frame shows the frame before (TRM paper Sec. 8): the faster the disc, the farther that ghost
   // lies from where full rate puts it, so its energy against full rate grows with speed (measured 125, 196, 244).
-  TempDir tmp;
+  CliTempDir tmp;
   double previous = 0.0;
   for (const int speed : {5, 20, 60}) {
     const std::string out = tmp.str("ncsfi" + std::to_string(speed));
@@ -479,7 +479,7 @@ TEST(Cli, CompareShowsNcsfiGhostingGrowWithSpeed) {
 }
 
 TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result run = run_trm("compare --scene panorama --size 216x120 --frames 8 --out " + tmp.str("cmp"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   for (const char* name : {"compare.md", "compare.csv", "report.json"}) {
@@ -596,7 +596,7 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
 // constant 10 deg/s yaw the path is the pinhole's analytic shift of the view's middle column, -f tan(10 deg t), frame
 // by frame; a scene that moves its world is pursued at one speed with Eq. 3's lag.
 TEST(Cli, CompareEyeFollowsTheHeadPosesFrameByFrame) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result run =
       run_trm("compare --methods full,reprojection --scene headturn --size 64x48 --frames 6 --out " + tmp.str("turn"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -627,7 +627,7 @@ TEST(Cli, CompareEyeFollowsTheHeadPosesFrameByFrame) {
 // Didyk et al.'s Fig. 8: upsampling 40 -> 120 Hz blurs a pursued edge less than native 40 Hz (each rendered frame held
 // three frames) and nearly as little as native 120 Hz, on the paper's hold-type LCD.
 TEST(Cli, DidykBlursLessThanNativeFortyHertzAndNearlyAsLittleAsOneTwenty) {
-  TempDir tmp;
+  CliTempDir tmp;
   const Result run = run_trm("compare --methods full,didyk,didyk:hold --scene discs --speed 20 --refresh 120 "
                              "--panel lcd --size 216x120 --frames 9 --out " + tmp.str("cmp"));
   ASSERT_EQ(run.exit_code, 0) << run.output;

@@ -1,4 +1,5 @@
 #include "analyze.hpp"
+#include "elapsed.hpp"
 
 #include "trm/display_method.hpp"
 #include "trm/panel_light.hpp"
@@ -705,7 +706,7 @@ AnalyzeResult run_analyze(const AnalyzeOptions& options,
     }
   }
   result.trends = check_trends(result);
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = seconds_since(start);
   if (progress) progress(total, total);
   return result;
 }

@@ -2,6 +2,7 @@
 // float32 decoder of the same per-pair math (bench/opencv_pipeline), in one process, repeats interleaved, on the same
 // encoded views at headset sizes, beside the resource report's memory (issue 13).
 #include "commands.hpp"
+#include "elapsed.hpp"
 #include "hw_report.hpp"
 #include "sweep.hpp"
 
@@ -320,11 +321,11 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
       // stores and output for the first time (page faults), so it is timed apart and then every view is timed.
       const auto warm0 = std::chrono::steady_clock::now();
       for (std::size_t v = 0; v < first_pair_views; ++v) decode(views[v]);
-      c.first_pair_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - warm0).count());
+      c.first_pair_seconds.push_back(seconds_since(warm0));
       const double cpu0 = process_cpu_seconds();
       const auto t0 = std::chrono::steady_clock::now();
       for (const LinkFrame& view : views) decode(view);
-      c.seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      c.seconds.push_back(seconds_since(t0));
       c.cpu_seconds.push_back(process_cpu_seconds() - cpu0);
       if (measure_memory) c.peak_rss_mib = peak_mib();
     }

@@ -3,6 +3,7 @@
 // frame is written as drive_NNNN.png (16 bit: round(v * 65535) of the unquantised drive) and
 // driveB_NNNN.png (the B-bit drive codes; 10-bit codes are stored in a 16-bit PNG).
 #include "commands.hpp"
+#include "elapsed.hpp"
 #include "output_dir.hpp"
 #include "link_report.hpp"
 #include "capture_replay.hpp"
@@ -134,7 +135,7 @@ void register_decode(CLI::App& app, Action& action) {
         write_drive_files(dir, view.slot, *view.decoded, options->output_bits);
       }).frames;
       recorder.close();
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double wall = seconds_since(start);
       dir.write_text("report.json", recorder.report(wall).dump(2) + "\n");
       dir.commit();
       std::cout << "trm decode: " << frames << " frames -> " << dir.target().string() << "/\n"

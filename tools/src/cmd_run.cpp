@@ -2,6 +2,7 @@
 // and writes report.json, the per-view and per-pair records (views.jsonl, pairs.jsonl, streamed as they come) and
 // PNG previews of the first frame pair into the output directory.
 #include "commands.hpp"
+#include "elapsed.hpp"
 #include "hw_report.hpp"
 #include "link_report.hpp"
 #include "output_dir.hpp"
@@ -95,7 +96,7 @@ void register_run(CLI::App& app, Action& action) {
       }, link_sink);
       progress.finish();
       recorder.close();
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double wall = seconds_since(start);
       Json report = recorder.report(wall);
       std::string link_lines;
       if (result.hardware) report["hardware"] = hardware_json(*result.hardware);

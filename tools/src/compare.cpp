@@ -1,4 +1,5 @@
 #include "compare.hpp"
+#include "elapsed.hpp"
 
 #include "pipeline.hpp"
 #include "xt_figure.hpp"
@@ -370,7 +371,7 @@ CompareResult run_compare(const CompareOptions& options,
           payload_sum += static_cast<double>(usage.bits.payload_bits);
           ++link_frames;
         });
-    measure.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    measure.seconds = seconds_since(start);
     meter.finish(measure);
     levels = meter.levels();
     profile = meter.profile();

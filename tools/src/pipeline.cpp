@@ -1,4 +1,5 @@
 #include "pipeline.hpp"
+#include "elapsed.hpp"
 
 #include "capture_replay.hpp"
 
@@ -9,14 +10,6 @@
 #include <stdexcept>
 
 namespace trm::cli {
-
-namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 PipelineResult run_pipeline(const PipelineOptions& options, const std::function<void(const DecodedView&)>& sink,
                             const std::function<void(const link::LinkFrameUsage&)>& link_sink) {

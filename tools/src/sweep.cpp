@@ -1,4 +1,5 @@
 #include "sweep.hpp"
+#include "elapsed.hpp"
 
 #include "compare.hpp"
 #include "hw_report.hpp"
@@ -20,10 +21,6 @@ namespace trm::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // A knob that is one int field of the configuration.
 SweepKnob field_knob(std::string name, std::string description, std::string cost, std::vector<int> values,

@@ -25,6 +25,7 @@ inline constexpr std::size_t kPacketHeaderBytes = 44;
 inline constexpr std::size_t kPacketCrcBytes = 4;
 inline constexpr std::size_t kPacketOverheadBytes = kPacketHeaderBytes + kPacketCrcBytes;
 inline constexpr int kMaxStreams = 2;  // stream = eye: 0 left (or mono), 1 right
+inline constexpr int kMaxDimension = 0xFFFF;  // the header's 16-bit size fields
 
 // Byte 24 of the header. Only interleaved RGB exists today; the field is there so that a future
 // format (e.g. YCbCr 4:2:0) is a new value, not a new packet version.
