@@ -33,6 +33,12 @@ void require_axis(int full, int reduced, const char* what) {
   }
 }
 
+// U's source and width, checked before any work by both upsample() and upsample_horizontal().
+void require_upsample_source(const cv::Mat& reduced, int full_width) {
+  if (reduced.depth() != CV_64F || reduced.empty()) throw std::invalid_argument("upsample: expected a non-empty CV_64F matrix");
+  require_axis(full_width, reduced.cols, "upsample (width)");
+}
+
 void require_sigma(double sigma) {
   if (!(sigma > 0.0) || !std::isfinite(sigma)) {
     throw std::invalid_argument("Gaussian sigma must be finite and > 0, got " + std::to_string(sigma));
@@ -199,8 +205,7 @@ cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, d
 }
 
 cv::Mat upsample_horizontal(const cv::Mat& reduced, int full_width) {
-  if (reduced.depth() != CV_64F || reduced.empty()) throw std::invalid_argument("upsample: expected a non-empty CV_64F matrix");
-  require_axis(full_width, reduced.cols, "upsample (width)");
+  require_upsample_source(reduced, full_width);
   const int channels = reduced.channels();
 
   std::vector<BilinearTap> col_taps(static_cast<std::size_t>(full_width));
@@ -232,8 +237,7 @@ void upsample_row(const cv::Mat& horizontal, int y, int full_height, double* out
 }
 
 cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height) {
-  if (reduced.depth() != CV_64F || reduced.empty()) throw std::invalid_argument("upsample: expected a non-empty CV_64F matrix");
-  require_axis(full_width, reduced.cols, "upsample (width)");
+  require_upsample_source(reduced, full_width);
   require_axis(full_height, reduced.rows, "upsample (height)");
   const cv::Mat horizontal = upsample_horizontal(reduced, full_width);
   cv::Mat full(full_height, full_width, reduced.type());
