@@ -18,6 +18,10 @@ install(TARGETS ${trm_installed_targets} EXPORT trmTargets
         ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
         INCLUDES DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
 install(TARGETS trm RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
+# The media plugin (trm/media.hpp) in lib/trm/, found by the installed trm relative to itself (so the prefix can
+# move) and by consumers through trm::encoder's run path.
+install(TARGETS trm_media LIBRARY DESTINATION "${TRM_MEDIA_INSTALL_DIR}")
+set_target_properties(trm PROPERTIES INSTALL_RPATH "$ORIGIN/../${TRM_MEDIA_INSTALL_DIR}")
 install(EXPORT trmTargets NAMESPACE trm:: DESTINATION "${trm_install_cmake_dir}")
 
 configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/trmConfig.cmake.in"

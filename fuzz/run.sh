@@ -47,7 +47,7 @@ header_dirs=("$root/link/include" "$root/link/src" "$root/encoder/include" "$roo
 
 # The library sources the targets reach, instrumented for coverage (fuzzer-no-link) and the sanitizers,
 # compiled TRM_FUZZ_JOBS at a time and rebuilt when a source or a project header is newer.
-sources=("$root"/link/src/*.cpp "$root"/encoder/src/{frame,transfer,sources}.cpp "$root"/encoder/src/scenes/scene_support.cpp
+sources=("$root"/link/src/*.cpp "$root"/encoder/src/{frame,transfer,sources,media}.cpp "$root"/encoder/src/scenes/scene_support.cpp
          "$root"/hw_models/src/panel.cpp "$root"/hw_models/src/lc_response.cpp "$root"/hw_models/src/lc_second_order.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp)
 compile() {  # SOURCE OBJECT HEADER_DIR... -- FLAGS...
   local src=$1 obj=$2 dirs=()
@@ -74,17 +74,23 @@ for program in "${targets[@]/#/fuzz_}" make_corpus make_seeds; do
   wait_for_slot
   compile "$here/$program.cpp" "$build/obj/$program.o" "${header_dirs[@]}" "$here" -- -fsanitize=fuzzer-no-link &
 done
+# The media plugin (encoder/plugin) linked into every program rather than loaded, so that OpenCV's decoders are
+# reached by the instrumented code it calls; an object of its own, since a weak reference (the loader's) does not
+# pull a member out of an archive.
+plugin_object="$build/obj/encoder_plugin_media_plugin.o"
+wait_for_slot
+compile "$root/encoder/plugin/media_plugin.cpp" "$plugin_object" "${header_dirs[@]}" -- -fsanitize=fuzzer-no-link &
 while (($(jobs -rp | wc -l))); do wait -n || exit 1; done
 rm -f "$build/libtrm_fuzz.a"
 ar rcs "$build/libtrm_fuzz.a" "${objects[@]}"
 
 for t in "${targets[@]}"; do
   wait_for_slot
-  "$cxx" "${sanitize[@]}" -fsanitize=fuzzer "$build/obj/fuzz_$t.o" "$build/libtrm_fuzz.a" "${libs[@]}" -o "$build/fuzz_$t" &
+  "$cxx" "${sanitize[@]}" -fsanitize=fuzzer "$build/obj/fuzz_$t.o" "$plugin_object" "$build/libtrm_fuzz.a" "${libs[@]}" -o "$build/fuzz_$t" &
 done
 for program in make_corpus make_seeds; do
   wait_for_slot
-  "$cxx" "${sanitize[@]}" "$build/obj/$program.o" "$build/libtrm_fuzz.a" "${libs[@]}" -o "$build/$program" &
+  "$cxx" "${sanitize[@]}" "$build/obj/$program.o" "$plugin_object" "$build/libtrm_fuzz.a" "${libs[@]}" -o "$build/$program" &
 done
 while (($(jobs -rp | wc -l))); do wait -n || exit 1; done
 

@@ -1,9 +1,9 @@
 // Real inputs: image sequences (glob) and video files, delivered as linear-light RGB frames.
 #include "scenes/scene_support.hpp"
+#include "trm/media.hpp"
 #include "trm/scene.hpp"
 
-#include <opencv2/videoio.hpp>
-#include <opencv2/videoio/registry.hpp>
+#include <opencv2/videoio.hpp>  // the CAP_* constants; the calls go through trm/media.hpp
 
 #include <algorithm>
 #include <filesystem>
@@ -159,12 +159,12 @@ class VideoSource final : public FrameSource {
     capture_.release();
     // Files go to FFmpeg when it is built in: probing every backend (GStreamer, camera drivers) for a
     // file that FFmpeg rejects only adds noise and slow start-up.
-    const int api = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
+    const int api = media::has_video_backend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
     if (!capture_.open(path_, api)) throw std::runtime_error("cannot open video file '" + path_ + "' (unsupported format or codec)");
   }
 
   std::string path_;
-  cv::VideoCapture capture_;
+  media::VideoReader capture_;
   cv::Mat current_bgr_;
   std::int64_t current_index_ = -1;
   cv::Size size_;

@@ -1,4 +1,5 @@
 // Analytic scenes: size, range, determinism, motion, and the exactness of their anti-aliasing.
+#include "trm/media.hpp"
 #include "trm/scene.hpp"
 #include "trm/transfer.hpp"
 
@@ -256,7 +257,7 @@ TEST(StaticScene, ShowsTheGivenImageInLinearLight) {
   cv::Mat bgr(6, 8, CV_8UC3);
   cv::randu(bgr, 0, 256);
   const std::string file = (dir / "still.png").string();
-  ASSERT_TRUE(cv::imwrite(file, bgr));
+  ASSERT_TRUE(media::write_image(file, bgr));
   SceneParams p = small_params(8, 6);
   p.image_path = file;
   auto s = make_scene("static", p);

@@ -1,10 +1,10 @@
 // Image sequences and video files: decoding to linear RGB, ordering, and clear errors for bad input.
+#include "trm/media.hpp"
 #include "trm/scene.hpp"
 #include "trm/transfer.hpp"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 
 #include <unistd.h>
 
@@ -27,10 +27,10 @@ class SourceTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  void write(const std::string& name, const cv::Mat& img) const { ASSERT_TRUE(cv::imwrite(path(name), img)) << name; }
+  void write(const std::string& name, const cv::Mat& img) const { ASSERT_TRUE(media::write_image(path(name), img)) << name; }
   // Float TIFF without compression: OpenCV's default for 3-channel float is lossy SGILOG (LogLuv).
   void write_float_tiff(const std::string& name, const cv::Mat& img) const {
-    ASSERT_TRUE(cv::imwrite(path(name), img, {cv::IMWRITE_TIFF_COMPRESSION, 1})) << name;
+    ASSERT_TRUE(media::write_image(path(name), img, {cv::IMWRITE_TIFF_COMPRESSION, 1})) << name;
   }
 
   // Expects `fn` to throw E whose message names `needle`.
@@ -120,8 +120,9 @@ TEST_F(SourceTest, DicomFilesAreRefusedBeforeOpenCvAbortsOnThem) {
 
 TEST_F(SourceTest, VideoFramesAreReadInAnyOrder) {
   const std::string file = path("clip.avi");
-  cv::VideoWriter writer(file, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0, cv::Size(32, 16));
-  if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV build cannot write MJPG/AVI";
+  media::VideoWriter writer;
+  constexpr int kMjpg = 'M' | ('J' << 8) | ('P' << 16) | ('G' << 24);  // cv::VideoWriter::fourcc's packing
+  if (!writer.open(file, kMjpg, 30.0, cv::Size(32, 16))) GTEST_SKIP() << "this OpenCV build cannot write MJPG/AVI";
   for (int i = 0; i < 5; ++i) writer.write(solid_bgr8(32, 16, 40 * i, 40 * i, 40 * i));
   writer.release();
 

@@ -308,6 +308,26 @@ TEST_F(BadInput, OutputsThatWouldClobber) {
 }
 
 // A view that lost every packet is what the panel shows too (its previous output, held): written and counted.
+// The plugin that reads and writes image files (trm/media.hpp) missing, or a library that is not it: one error
+// naming it and what was tried, no output.
+TEST_F(BadInput, MediaPluginThatCannotBeLoaded) {
+  struct PluginVariable {
+    explicit PluginVariable(const char* value) { ::setenv("TRM_MEDIA_PLUGIN", value, 1); }
+    ~PluginVariable() { ::unsetenv("TRM_MEDIA_PLUGIN"); }
+  };
+  const std::string reads_an_image = "run --input '{f}/run_mono/pair_sent_full.png' --frames 2 --out o";
+  const std::string writes_images = "run --scene discs --size 16x12 --frames 2 --out o";
+  {
+    const PluginVariable missing("/nonexistent/libtrm_media.so");
+    expect_clean_failure(reads_an_image, "libtrm_media.so (it reads and writes image and video files");
+    expect_clean_failure(writes_images, "/nonexistent/libtrm_media.so: cannot open shared object file");
+  }
+  {
+    const PluginVariable not_the_plugin("libz.so.1");
+    expect_clean_failure(reads_an_image, "libz.so.1: no symbol trm_media_plugin_api");
+  }
+}
+
 TEST_F(BadInput, LostViewsAreWrittenAndCounted) {
   ScratchDir scratch("trm-lost-view-");
   const fs::path f = fixtures_->path();

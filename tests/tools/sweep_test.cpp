@@ -5,6 +5,7 @@
 #include "pipeline.hpp"
 #include "sweep.hpp"
 #include "sweep_report.hpp"
+#include "trm/media.hpp"
 #include "trm_process.hpp"
 
 #include <gtest/gtest.h>
@@ -60,14 +61,14 @@ TEST(Sweep, QuickWritesEveryFileWithOneRowPerKnobAndValue) {
       EXPECT_FALSE(fs::exists(plot)) << knob.name;
       continue;
     }
-    const cv::Mat image = cv::imread(plot.string());
+    const cv::Mat image = trm::media::read_image(plot.string(), cv::IMREAD_COLOR);
     EXPECT_FALSE(image.empty()) << plot;
     EXPECT_EQ(image.cols, 1620) << plot;
     EXPECT_EQ(image.rows, 500) << plot;
     values_of[knob.name] = knob.values.size();
     expected_rows += knob.values.size();
   }
-  const cv::Mat pareto = cv::imread((out / "sweep_pareto.png").string());
+  const cv::Mat pareto = trm::media::read_image((out / "sweep_pareto.png").string(), cv::IMREAD_COLOR);
   EXPECT_EQ(pareto.cols, 1800);
   EXPECT_EQ(pareto.rows, 560);
   std::vector<std::string> header;
@@ -460,10 +461,11 @@ TEST(Sweep, LcModelIsWrittenWithItsValueNames) {
   EXPECT_EQ(report["pareto"][3]["chart"], "LC model: error vs eye-model time");
   for (const auto& point : report["pareto"][3]["front"]) EXPECT_EQ(point["knob"], "lc_model");
   EXPECT_EQ(report["knobs"][0]["points"][3]["value_label"], "second+overdrive");
-  EXPECT_EQ(cv::imread((out / "sweep_pareto.png").string()).cols, 2400);
+  EXPECT_EQ(trm::media::read_image((out / "sweep_pareto.png").string(), cv::IMREAD_COLOR).cols, 2400);
   const auto list = run_trm("sweep --list-knobs");
   ASSERT_EQ(list.exit_code, 0) << list.output;
   EXPECT_NE(list.output.find("lc_model"), std::string::npos) << list.output;
   EXPECT_NE(list.output.find("3=second+overdrive"), std::string::npos) << list.output;
   EXPECT_NE(list.output.find("(LCD panel only)"), std::string::npos) << list.output;
 }
+

@@ -1,6 +1,7 @@
 // End-to-end checks of the `trm` command line: exit codes, messages, outputs written whole or not at all.
 #include "trm_process.hpp"
 
+#include "trm/media.hpp"
 #include "trm/metrics.hpp"
 
 #include <gtest/gtest.h>
@@ -40,7 +41,7 @@ void write_frames(const fs::path& dir, int n, int width, int height, bool same =
     if (i == 0 || !same) rng.fill(frame, cv::RNG::UNIFORM, 0, 256);
     char name[32];
     std::snprintf(name, sizeof name, "frame_%03d.png", i);
-    ASSERT_TRUE(cv::imwrite((dir / name).string(), frame));
+    ASSERT_TRUE(trm::media::write_image((dir / name).string(), frame));
   }
 }
 
@@ -63,8 +64,8 @@ DriveAgreement compare_drive_files(const fs::path& dir, const fs::path& referenc
   for (int t = 0; t < frames; ++t) {
     char name[32];
     std::snprintf(name, sizeof name, "drive8_%04d.png", t);
-    const cv::Mat codes = cv::imread((dir / name).string(), cv::IMREAD_UNCHANGED);
-    const cv::Mat reference = cv::imread((reference_dir / name).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat codes = trm::media::read_image((dir / name).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat reference = trm::media::read_image((reference_dir / name).string(), cv::IMREAD_UNCHANGED);
     if (codes.empty() && reference.empty()) continue;
     if (codes.empty() || reference.empty()) {
       ADD_FAILURE() << name << " written by only one of " << dir << " and " << reference_dir;
@@ -112,13 +113,13 @@ TEST(Cli, DecodeWritesDriveFramesAtBothDepths) {
   for (int t = 0; t < 4; ++t) {
     char name[32];
     std::snprintf(name, sizeof name, "drive8_%04d.png", t);
-    const cv::Mat codes = cv::imread(tmp.str("out8/") + name, cv::IMREAD_UNCHANGED);
+    const cv::Mat codes = trm::media::read_image(tmp.str("out8/") + name, cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(codes.empty()) << name;
     EXPECT_EQ(codes.depth(), CV_8U);
     EXPECT_EQ(codes.cols, 17);
     EXPECT_EQ(codes.rows, 11);
     std::snprintf(name, sizeof name, "drive_%04d.png", t);
-    const cv::Mat drive = cv::imread(tmp.str("out8/") + name, cv::IMREAD_UNCHANGED);
+    const cv::Mat drive = trm::media::read_image(tmp.str("out8/") + name, cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(drive.empty()) << name;
     EXPECT_EQ(drive.depth(), CV_16U);
     // The 8-bit codes are the 16-bit drive quantised: they agree to within one 8-bit step.
@@ -133,7 +134,7 @@ TEST(Cli, DecodeWritesDriveFramesAtBothDepths) {
   const Result r10 =
       run_trm("decode --input '" + tmp.str("in/frame_*.png") + "' --out " + tmp.str("out10") + " --bits 10");
   ASSERT_EQ(r10.exit_code, 0) << r10.output;
-  const cv::Mat codes10 = cv::imread(tmp.str("out10/drive10_0001.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat codes10 = trm::media::read_image(tmp.str("out10/drive10_0001.png"), cv::IMREAD_UNCHANGED);
   ASSERT_FALSE(codes10.empty());
   EXPECT_EQ(codes10.depth(), CV_16U);
   double max_code = 0;
@@ -151,7 +152,7 @@ TEST(Cli, DecodeBadInputsFailCleanlyWithoutPartialOutput) {
   };
   fs::create_directories(tmp.path() / "mixed");
   write_frames(tmp.path() / "mixed", 1, 8, 6);
-  ASSERT_TRUE(cv::imwrite(tmp.str("mixed/frame_001.png"), cv::Mat(7, 8, CV_8UC3, cv::Scalar::all(3))));
+  ASSERT_TRUE(trm::media::write_image(tmp.str("mixed/frame_001.png"), cv::Mat(7, 8, CV_8UC3, cv::Scalar::all(3))));
   fs::create_directories(tmp.path() / "notimage");
   { std::ofstream(tmp.path() / "notimage" / "frame_000.png") << "this is not a PNG"; }
 
@@ -241,7 +242,7 @@ TEST(Cli, RunWritesReportAndPreviews) {
                            "pair_shown_alpha.png", "pair_perceived.png", "pair_full_rate_reference.png"}) {
     EXPECT_TRUE(fs::exists(tmp.path() / "out" / name)) << name;
   }
-  const cv::Mat reduced = cv::imread(tmp.str("out/pair_sent_reduced.png"));
+  const cv::Mat reduced = trm::media::read_image(tmp.str("out/pair_sent_reduced.png"), cv::IMREAD_COLOR);
   EXPECT_EQ(reduced.cols, 24);
   EXPECT_EQ(reduced.rows, 20);
   // Running again over our own output replaces it.
@@ -349,8 +350,8 @@ TEST(Cli, RunWithLinkFaultsDecodesWithTheFixedPointModel) {
   for (int t = 0; t < 6; ++t) {
     char name[32];
     std::snprintf(name, sizeof name, "/drive8_%04d.png", t);
-    const cv::Mat streaming = cv::imread(tmp.str("fixed") + name, cv::IMREAD_UNCHANGED);
-    const cv::Mat frame = cv::imread(tmp.str("fixed-frame") + name, cv::IMREAD_UNCHANGED);
+    const cv::Mat streaming = trm::media::read_image(tmp.str("fixed") + name, cv::IMREAD_UNCHANGED);
+    const cv::Mat frame = trm::media::read_image(tmp.str("fixed-frame") + name, cv::IMREAD_UNCHANGED);
     if (streaming.empty() && frame.empty()) continue;  // a view the link lost entirely is not in the capture
     ASSERT_FALSE(streaming.empty() || frame.empty()) << t;
     EXPECT_EQ(cv::norm(streaming, frame, cv::NORM_INF), 0.0) << t;
@@ -367,7 +368,7 @@ TEST(Cli, CaptureReplaysIntoDecodeAndFeed) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   ASSERT_TRUE(fs::exists(tmp.path() / "run" / "link.trmcap"));
   ASSERT_TRUE(fs::exists(tmp.path() / "run" / "frames.csv"));
-  const cv::Mat bits_plot = cv::imread(tmp.str("run/link_bits.png"));
+  const cv::Mat bits_plot = trm::media::read_image(tmp.str("run/link_bits.png"), cv::IMREAD_COLOR);
   ASSERT_FALSE(bits_plot.empty());
   EXPECT_EQ(bits_plot.cols, 1200);
   EXPECT_EQ(bits_plot.rows, 640);
@@ -442,8 +443,8 @@ TEST(Cli, CaptureOfAHalfRateRunReplaysWithItsUnsentSlots) {
     EXPECT_EQ(v["lost"], false) << v.dump();
   }
   // The repeat is the rendered frame again, code for code.
-  const cv::Mat shown = cv::imread(tmp.str("dec/drive8_0002.png"), cv::IMREAD_UNCHANGED);
-  const cv::Mat repeated = cv::imread(tmp.str("dec/drive8_0003.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat shown = trm::media::read_image(tmp.str("dec/drive8_0002.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat repeated = trm::media::read_image(tmp.str("dec/drive8_0003.png"), cv::IMREAD_UNCHANGED);
   ASSERT_FALSE(shown.empty() || repeated.empty());
   EXPECT_EQ(cv::norm(shown, repeated, cv::NORM_INF), 0.0);
   std::ifstream in(tmp.str("dec/report.json"));
@@ -533,7 +534,7 @@ TEST(Cli, CompareMeasuresEveryMethodOnTheSameFrames) {
     EXPECT_TRUE(m["motion_blur_arcmin"].is_null()) << name;
     EXPECT_GE(m["judder"].get<double>(), 0.0) << name;
     // Fig. 12 of every method: four panels of the x-t view, written whole.
-    const cv::Mat figure = cv::imread(tmp.str("cmp/fig12_" + name + ".png"), cv::IMREAD_UNCHANGED);
+    const cv::Mat figure = trm::media::read_image(tmp.str("cmp/fig12_" + name + ".png"), cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(figure.empty()) << name;
     EXPECT_EQ(figure.channels(), 3) << name;
     EXPECT_GT(figure.cols, 4 * figure.rows / 4) << name;

@@ -9,6 +9,7 @@
 #include "trm/encoder.hpp"
 #include "trm/encoder_json.hpp"
 #include "trm/fixed_decoder.hpp"
+#include "trm/media.hpp"
 #include "trm/metrics.hpp"
 #include "trm/mtcd.hpp"
 #include "trm/panel.hpp"
@@ -16,7 +17,7 @@
 #include "trm/visual_difference.hpp"
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the IMREAD_* flags; the calls go through trm/media.hpp
 #include <opencv2/imgproc.hpp>
 #include <pybind11/stl.h>
 
@@ -530,7 +531,7 @@ PYBIND11_MODULE(trm, m) {
         "one row per time sample, one column per pixel of the line).");
 
   m.def("read_png", [](const std::string& path) {
-          cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+          cv::Mat image = media::read_image(path, cv::IMREAD_UNCHANGED);
           if (image.empty()) throw std::invalid_argument("read_png: cannot read an image from '" + path + "'");
           if (image.channels() != 3) {
             throw std::invalid_argument("read_png: '" + path + "' has " + std::to_string(image.channels()) +
@@ -546,7 +547,7 @@ PYBIND11_MODULE(trm, m) {
           cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
           bool written = false;
           try {
-            written = cv::imwrite(path, bgr);
+            written = media::write_image(path, bgr);
           } catch (const cv::Exception& e) {
             throw std::invalid_argument("write_png: cannot write '" + path + "': " + e.what());
           }

@@ -1,7 +1,8 @@
 #include "output_dir.hpp"
 
+#include "trm/media.hpp"
+
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <fcntl.h>
@@ -141,7 +142,7 @@ void OutputDir::write_png(const std::string& name, const cv::Mat& rgb) const {
   std::vector<std::uint8_t> png;
   bool ok = false;
   try {
-    ok = cv::imencode(".png", bgr, png);
+    ok = media::encode_image(".png", bgr, png);
   } catch (const cv::Exception& e) {
     throw std::runtime_error("cannot encode '" + (target_ / name).string() + "' as PNG: " + e.what());
   }

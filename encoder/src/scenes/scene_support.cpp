@@ -1,8 +1,9 @@
 #include "scenes/scene_support.hpp"
 
+#include "trm/media.hpp"
 #include "trm/transfer.hpp"
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the IMREAD_* flags; the calls go through trm/media.hpp
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -278,7 +279,7 @@ cv::Mat load_linear_image(const std::string& path) {
     throw std::runtime_error("image '" + path + "' is a DICOM file (\"DICM\" at byte 128); DICOM images are not supported");
   cv::Mat img;
   try {
-    img = cv::imread(path, cv::IMREAD_UNCHANGED);
+    img = media::read_image(path, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     throw std::runtime_error("cannot read image '" + path + "': " + e.what());
   }
