@@ -4,10 +4,15 @@
 #include "media_plugin_abi.hpp"
 
 #include <dlfcn.h>
+#include <link.h>
+#include <unistd.h>
 
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 // Defined when the plugin's source is linked into the program itself (the fuzz targets); null otherwise.
 extern "C" const trm::media::plugin::Api* trm_media_plugin_api() __attribute__((weak));
@@ -55,6 +60,29 @@ const Api* open_plugin(const std::string& file, std::string& tried) {
   return api;  // the handle stays open for the life of the process
 }
 
+// The directories the dynamic loader searches for a library needed by the object this code is linked into (the
+// program, or a shared object such as the Python module): LD_LIBRARY_PATH, that object's run path, the system's.
+// Read with dlinfo rather than left to dlopen, whose search uses the run path of the object that calls it, which is
+// not this one where a sanitizer's interceptor stands between.
+std::vector<std::string> search_directories() {
+  Dl_info self_info{};
+  void* self = nullptr;
+  if (dladdr(reinterpret_cast<void*>(&search_directories), &self_info) != 0 && self_info.dli_fname != nullptr) {
+    self = dlopen(self_info.dli_fname, RTLD_LAZY | RTLD_NOLOAD);
+  }
+  if (self == nullptr) self = dlopen(nullptr, RTLD_LAZY);  // the program itself
+  std::vector<std::string> directories;
+  Dl_serinfo size{};
+  if (self == nullptr || dlinfo(self, RTLD_DI_SERINFOSIZE, &size) != 0) return directories;
+  std::vector<std::max_align_t> storage(size.dls_size / sizeof(std::max_align_t) + 1);
+  auto* info = reinterpret_cast<Dl_serinfo*>(storage.data());
+  info->dls_size = size.dls_size;
+  info->dls_cnt = size.dls_cnt;
+  if (dlinfo(self, RTLD_DI_SERINFOSIZE, info) != 0 || dlinfo(self, RTLD_DI_SERINFO, info) != 0) return directories;
+  for (unsigned int i = 0; i < info->dls_cnt; ++i) directories.emplace_back(info->dls_serpath[i].dls_name);
+  return directories;
+}
+
 const Api* load() {
   std::string tried;
   if (trm_media_plugin_api != nullptr) {
@@ -64,8 +92,13 @@ const Api* load() {
     // A plugin chosen by name is not replaced by another one found elsewhere.
     if (const Api* api = open_plugin(chosen, tried)) return api;
     tried += " (" + std::string(kPluginVariable) + "=" + chosen + ")";
-  } else if (const Api* api = open_plugin(kPluginFile, tried)) {
-    return api;
+  } else {
+    for (const std::string& directory : search_directories()) {
+      const std::string candidate = (directory.empty() ? std::string(".") : directory) + "/" + kPluginFile;
+      if (::access(candidate.c_str(), F_OK) != 0) continue;
+      if (const Api* api = open_plugin(candidate, tried)) return api;
+    }
+    if (const Api* api = open_plugin(kPluginFile, tried)) return api;  // the loader's cache
   }
   throw std::runtime_error(std::string("cannot load trm's image and video plugin ") + kPluginFile +
                            " (it reads and writes image and video files through OpenCV)" + tried + "; set " +
