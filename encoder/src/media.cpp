@@ -72,14 +72,18 @@ std::vector<std::string> search_directories() {
   }
   if (self == nullptr) self = dlopen(nullptr, RTLD_LAZY);  // the program itself
   std::vector<std::string> directories;
+  if (self == nullptr) return directories;
   Dl_serinfo size{};
-  if (self == nullptr || dlinfo(self, RTLD_DI_SERINFOSIZE, &size) != 0) return directories;
-  std::vector<std::max_align_t> storage(size.dls_size / sizeof(std::max_align_t) + 1);
-  auto* info = reinterpret_cast<Dl_serinfo*>(storage.data());
-  info->dls_size = size.dls_size;
-  info->dls_cnt = size.dls_cnt;
-  if (dlinfo(self, RTLD_DI_SERINFOSIZE, info) != 0 || dlinfo(self, RTLD_DI_SERINFO, info) != 0) return directories;
-  for (unsigned int i = 0; i < info->dls_cnt; ++i) directories.emplace_back(info->dls_serpath[i].dls_name);
+  if (dlinfo(self, RTLD_DI_SERINFOSIZE, &size) == 0) {
+    std::vector<std::max_align_t> storage(size.dls_size / sizeof(std::max_align_t) + 1);
+    auto* info = reinterpret_cast<Dl_serinfo*>(storage.data());
+    info->dls_size = size.dls_size;
+    info->dls_cnt = size.dls_cnt;
+    if (dlinfo(self, RTLD_DI_SERINFOSIZE, info) == 0 && dlinfo(self, RTLD_DI_SERINFO, info) == 0) {
+      for (unsigned int i = 0; i < info->dls_cnt; ++i) directories.emplace_back(info->dls_serpath[i].dls_name);
+    }
+  }
+  dlclose(self);  // both opens only counted a reference to an object already loaded
   return directories;
 }
 

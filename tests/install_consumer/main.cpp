@@ -2,10 +2,12 @@
 // decoders and the reference, and checks what the design guarantees: the full view's codes are the link quantisation
 // of the scene's sRGB encoding (computed here from IEC 61966-2-1, not by trm), the reduced view has the reduced size
 // of DESIGN §3, the streaming and frame-at-a-time fixed-point decoders agree bit for bit, and the fixed-point output
-// meets DESIGN §6 against the reference. Exit status 0 only when all of it holds.
+// meets DESIGN §6 against the reference; the drive codes written as a PNG through the installed media plugin read
+// back the same. Exit status 0 only when all of it holds.
 #include "trm/decoder.hpp"
 #include "trm/encoder.hpp"
 #include "trm/fixed_decoder.hpp"
+#include "trm/media.hpp"
 #include "trm/metrics.hpp"
 #include "trm/scene.hpp"
 
@@ -46,7 +48,11 @@ bool codes_are_link_quantisation(const cv::Mat& linear, const cv::Mat& codes) {
 
 }  // namespace
 
-int main() try {
+int main(int argc, char** argv) try {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: consumer PNG_PATH\n");
+    return 2;
+  }
   const int width = 64, height = 48;
   trm::SceneParams params;
   params.width = width;
@@ -61,6 +67,7 @@ int main() try {
 
   trm::CodeAgreement against_reference;
   bool streaming_equals_frame = true;
+  cv::Mat last_codes;
   for (std::int64_t t = 0; t < 2; ++t) {
     const cv::Mat linear = scene->linear_frame(t);
     const trm::LinkFrame view = encoder.encode(linear, t);
@@ -79,7 +86,13 @@ int main() try {
     check(a.drive_codes.size() == cv::Size(width, height), "decoded at the full view size");
     streaming_equals_frame = streaming_equals_frame && cv::norm(a.drive_codes, b.drive_codes, cv::NORM_INF) == 0.0;
     against_reference += trm::compare_codes(a.drive_codes, r.drive_codes);
+    last_codes = a.drive_codes;
   }
+  check(trm::media::write_image(argv[1], last_codes), "drive codes written as a PNG through the media plugin");
+  const cv::Mat read_back = trm::media::read_image(argv[1], -1);  // cv::IMREAD_UNCHANGED
+  check(read_back.type() == last_codes.type() && read_back.size() == last_codes.size() &&
+            cv::norm(read_back, last_codes, cv::NORM_INF) == 0.0,
+        "the PNG reads back as the same codes");
   check(streaming_equals_frame, "streaming and frame-at-a-time fixed-point decoders agree bit for bit");
   check(trm::kReferenceAgreementCriterion.met_by(against_reference), "fixed point meets DESIGN 6 against the reference");
   std::printf("%lld of %lld codes identical to the reference, max %g LSB\n",
