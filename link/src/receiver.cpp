@@ -4,6 +4,7 @@
 #include "bit_packing.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <exception>
 
 namespace trm::link {
@@ -103,11 +104,14 @@ PushResult Receiver::push(std::span<const std::uint8_t> bytes) {
     // Sizes were checked against the receiver's limits by parse_packet before this allocation.
     a.active = true;
     a.meta = meta;
-    a.codes = cv::Mat::zeros(h.height, h.width, CV_16UC3);
+    // Not cleared: every line is either covered whole by accepted packets or zeroed when handed out.
+    a.codes.create(h.height, h.width, CV_16UC3);
     a.coverage = cv::Mat::zeros(h.height, h.width, CV_8U);
   }
   scratch_.copyTo(a.codes(rect));
-  a.coverage(rect).setTo(1);
+  for (int y = rect.y; y < rect.y + rect.height; ++y) {  // row by row: cv::Mat::setTo costs more than the copy
+    std::memset(a.coverage.ptr<std::uint8_t>(y) + rect.x, 1, static_cast<std::size_t>(rect.width));
+  }
 
   if (have_sequence_[h.stream] && h.sequence != expected_sequence_[h.stream]) {
     // Unsigned difference: correct across the 2^32 wrap. A sequence that went backwards is a resent or

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 
 namespace trm::rig::testing {
@@ -61,6 +62,24 @@ TEST(RigProtocol, SamplesAreRowMajorRgbAndTenBitIsLittleEndian) {
   f.bits = 8;
   f.samples = {255, 1, 2, 3, 4, 5};
   EXPECT_EQ(pack_samples(f), (std::vector<std::uint8_t>{255, 1, 2, 3, 4, 5}));
+}
+
+// validate() finds a code above 2^bits - 1 by one OR over the frame: checked at every depth, with the offending code
+// at every position of a vector's width and in the tail, and with every single bit above the depth.
+TEST(RigProtocol, CodesAboveTheBitDepthAreRefusedWherever) {
+  for (int bits = 1; bits <= 16; ++bits) {
+    RigFrame f = synthetic_frame(0, 0, 13, 3, bits);  // 117 samples: vector bodies and a tail
+    const auto top = static_cast<std::uint16_t>((1u << bits) - 1u);
+    std::fill(f.samples.begin(), f.samples.end(), top);
+    EXPECT_NO_THROW(f.validate()) << bits << " bits, every code at the top";
+    for (int bit = bits; bit < 16; ++bit) {
+      for (std::size_t at : {std::size_t{0}, std::size_t{31}, std::size_t{64}, f.samples.size() - 1}) {
+        RigFrame over = f;
+        over.samples[at] = static_cast<std::uint16_t>(over.samples[at] | (1u << bit));
+        EXPECT_THROW(over.validate(), std::invalid_argument) << bits << " bits, bit " << bit << " set at " << at;
+      }
+    }
+  }
 }
 
 TEST(RigProtocol, ChunkAndEndLayout) {

@@ -157,10 +157,10 @@ rig::RigFrame to_rig_frame(const DecodedFrame& decoded, int bits) {
   f.width = codes.cols;
   f.height = codes.rows;
   f.bits = bits;
-  f.samples.resize(static_cast<std::size_t>(codes.cols) * static_cast<std::size_t>(codes.rows) * 3u);
+  f.samples.reserve(static_cast<std::size_t>(codes.cols) * static_cast<std::size_t>(codes.rows) * 3u);
   for (int y = 0; y < codes.rows; ++y) {
     const auto* row = codes.ptr<std::uint16_t>(y);
-    std::copy(row, row + codes.cols * 3, f.samples.begin() + static_cast<std::ptrdiff_t>(y) * codes.cols * 3);
+    f.samples.insert(f.samples.end(), row, row + codes.cols * 3);
   }
   return f;
 }
