@@ -98,7 +98,7 @@ class ShadowRig final : public RigTransport {
         check(state_ == State::Sending && next_ == start_.chunk_count, "FRAME_END before the last chunk");
         const FrameEnd e = decode_frame_end(packet);
         check(e.frame_index == start_.frame_index && e.chunk_count == start_.chunk_count &&
-                  e.payload_crc == start_.payload_crc && crc32_of(payload_) == start_.payload_crc,
+                  e.payload_crc == start_.payload_crc && crc32_ieee(payload_) == start_.payload_crc,
               "FRAME_END does not match the frame");
         check(payload_ == pack_samples(*frame), "reassembled payload differs from the frame");
         frame_complete = true;

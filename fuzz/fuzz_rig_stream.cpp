@@ -21,9 +21,9 @@ void put_u32(std::uint8_t* p, std::uint32_t v) {
 
 void repair_header_crc(std::vector<std::uint8_t>& packet) {
   if (packet[0] == static_cast<std::uint8_t>(PacketType::FrameStart) && packet.size() >= kFrameStartSize)
-    put_u32(&packet[60], crc32_of(std::span(packet).first(60)));
+    put_u32(&packet[60], crc32_ieee(std::span(packet).first(60)));
   if (packet[0] == static_cast<std::uint8_t>(PacketType::FrameEnd) && packet.size() >= kFrameEndSize)
-    put_u32(&packet[20], crc32_of(std::span(packet).first(20)));
+    put_u32(&packet[20], crc32_ieee(std::span(packet).first(20)));
 }
 
 }  // namespace

@@ -41,7 +41,7 @@ includes=(-I"$root/link/include" -I"$root/link/src" -I"$root/encoder/include" -I
           -I"$root/hw_models/include" -I"$root/fixed_point/include" -I"$root/tools/src" -I"$root/tools/rig/include" -isystem /usr/include/opencv4 -isystem /usr/include/eigen3)
 common=(-std=c++20 -g -O1 -fno-omit-frame-pointer "${includes[@]}")
 sanitize=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
-libs=(-lcharls -lz -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lopencv_core)
+libs=(-lcharls -ldeflate -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lopencv_core)
 header_dirs=("$root/link/include" "$root/link/src" "$root/encoder/include" "$root/encoder/src"
              "$root/hw_models/include" "$root/fixed_point/include" "$root/tools/src" "$root/tools/rig/include")
 

@@ -17,7 +17,7 @@ packages=(
   libsystemc-dev           # sc_fixed: independent oracle for the fixed-point type; the decoder as a SystemC module
   libcli11-dev             # command-line parsing
   nlohmann-json3-dev       # report.json
-  zlib1g-dev               # CRC32 for link packets
+  libdeflate-dev           # CRC-32 of link packets, captures and rig frames (carry-less multiply, chosen at run time)
   libcharls-dev            # JPEG-LS lossless link codec
   libplplot-dev            # the plots (PLplot)
   libeigen3-dev            # Levenberg-Marquardt least squares of `trm calibrate` (Eq. 7 fit); the matrix exponential of the second-order LC model; head-pose quaternions and slerp

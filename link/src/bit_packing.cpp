@@ -30,21 +30,26 @@ void pack_codes(const cv::Mat& codes, const cv::Rect& rect, int bits, std::vecto
   if (held > 0) out.push_back(static_cast<std::uint8_t>(acc << (8 - held)));
 }
 
+bool raw_padding_is_zero(std::span<const std::uint8_t> payload, int bits, const cv::Rect& rect) {
+  const std::uint64_t total_bits = static_cast<std::uint64_t>(rect.width) * 3u * static_cast<std::uint64_t>(rect.height) *
+                                   static_cast<std::uint64_t>(bits);
+  const int padding = static_cast<int>(payload.size() * 8u - total_bits);
+  return padding <= 0 || (payload.back() & ((1u << padding) - 1u)) == 0;
+}
+
 bool unpack_codes(std::span<const std::uint8_t> payload, int bits, cv::Mat& codes, const cv::Rect& rect) {
   const int components = rect.width * 3;
+  if (!raw_padding_is_zero(payload, bits, rect)) return false;
   if (bits == 8) {
+    // Through restrict pointers: a byte load may alias the stores otherwise, which keeps the loop scalar.
     const std::uint8_t* src = payload.data();
-    for (int y = rect.y; y < rect.y + rect.height; ++y) {
-      std::uint16_t* row = codes.ptr<std::uint16_t>(y) + rect.x * 3;
-      for (int i = 0; i < components; ++i) row[i] = *src++;
+    for (int y = rect.y; y < rect.y + rect.height; ++y, src += components) {
+      const std::uint8_t* __restrict in = src;
+      std::uint16_t* __restrict row = codes.ptr<std::uint16_t>(y) + rect.x * 3;
+      for (int i = 0; i < components; ++i) row[i] = in[i];
     }
     return true;
   }
-  const std::uint64_t total_bits =
-      static_cast<std::uint64_t>(components) * static_cast<std::uint64_t>(rect.height) * static_cast<std::uint64_t>(bits);
-  const int padding = static_cast<int>(payload.size() * 8u - total_bits);
-  if (padding > 0 && (payload.back() & ((1u << padding) - 1u)) != 0) return false;
-
   const std::uint32_t mask = (1u << bits) - 1u;
   std::uint64_t acc = 0;
   int held = 0;

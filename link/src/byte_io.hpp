@@ -1,4 +1,4 @@
-// Little-endian field access and the packaged CRC-32 (zlib), shared by the packet and capture code.
+// Little-endian field access, shared by the packet and capture code (their CRC-32: trm/crc32.hpp).
 #pragma once
 
 #include <cstddef>
@@ -30,8 +30,5 @@ inline std::uint64_t get_u64(const std::uint8_t* p) {
   for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
   return v;
 }
-
-// CRC-32 (IEEE 802.3 polynomial, reflected, init and final XOR 0xFFFFFFFF) as zlib computes it.
-std::uint32_t crc32_of(std::span<const std::uint8_t> bytes);
 
 }  // namespace trm::link::detail

@@ -39,8 +39,8 @@ std::optional<ReceivedFrame> CaptureReplay::next_frame() {
     if (finished_) return std::nullopt;
     pending_.clear();
     next_pending_ = 0;
-    if (std::optional<std::vector<std::uint8_t>> packet = reader_.next_packet()) {
-      receiver_.push(*packet);
+    if (reader_.next_packet(packet_)) {
+      receiver_.push(packet_);
     } else {
       receiver_.flush();
       finished_ = true;

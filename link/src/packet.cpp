@@ -1,4 +1,5 @@
 #include "trm/packet.hpp"
+#include "trm/crc32.hpp"
 
 #include "byte_io.hpp"
 
@@ -90,7 +91,7 @@ std::uint64_t raw_payload_bytes(int columns, int lines, int bits) {
 
 std::uint32_t packet_crc(std::span<const std::uint8_t> packet) {
   if (packet.size() < kPacketCrcBytes) return 0;
-  return detail::crc32_of(packet.first(packet.size() - kPacketCrcBytes));
+  return crc32_ieee(packet.first(packet.size() - kPacketCrcBytes));
 }
 
 std::vector<std::uint8_t> build_packet(PacketHeader h, std::span<const std::uint8_t> payload) {

@@ -83,11 +83,12 @@ PushResult Receiver::push(std::span<const std::uint8_t> bytes) {
     return PushResult::Duplicate;
   }
 
-  // Decode into scratch first, so that a bad payload leaves the view untouched.
-  scratch_.create(h.line_count, h.column_count, CV_16UC3);
+  // A bad payload must leave the view untouched (and start none): a raw one is checked before it is unpacked into
+  // the view, a JPEG-LS one is decoded into scratch first.
   const cv::Rect whole(0, 0, h.column_count, h.line_count);
-  if (h.coding == PayloadCoding::Raw) {
-    if (!detail::unpack_codes(parsed->payload, h.bits, scratch_, whole)) {
+  const bool raw = h.coding == PayloadCoding::Raw;
+  if (raw) {
+    if (!detail::raw_padding_is_zero(parsed->payload, h.bits, whole)) {
       ++counters_.malformed;
       return PushResult::Malformed;
     }
@@ -108,7 +109,8 @@ PushResult Receiver::push(std::span<const std::uint8_t> bytes) {
     a.codes.create(h.height, h.width, CV_16UC3);
     a.coverage = cv::Mat::zeros(h.height, h.width, CV_8U);
   }
-  scratch_.copyTo(a.codes(rect));
+  if (raw) detail::unpack_codes(parsed->payload, h.bits, a.codes, rect);
+  else scratch_.copyTo(a.codes(rect));
   for (int y = rect.y; y < rect.y + rect.height; ++y) {  // row by row: cv::Mat::setTo costs more than the copy
     std::memset(a.coverage.ptr<std::uint8_t>(y) + rect.x, 1, static_cast<std::size_t>(rect.width));
   }

@@ -236,6 +236,43 @@ TEST(Packet, NonZeroPaddingIsMalformed) {
   Receiver rx;
   EXPECT_EQ(rx.push(p), PushResult::Malformed);
   EXPECT_EQ(rx.counters().malformed, 1u);
+  rx.flush();
+  EXPECT_TRUE(rx.take_frames().empty()) << "a malformed packet starts no view";
+}
+
+TEST(Packet, MalformedPacketLeavesTheViewItLandsInUntouched) {
+  LinkFrame f;
+  f.meta.width = f.meta.full_width = 1;
+  f.meta.height = f.meta.full_height = 2;
+  f.meta.bits = 10;
+  f.codes = cv::Mat(2, 1, CV_16UC3, cv::Scalar(1, 2, 3));
+  f.codes.at<cv::Vec3w>(1, 0) = cv::Vec3w(700, 800, 900);
+  Transmitter tx;
+  const std::vector<std::vector<std::uint8_t>> packets = tx.send(f).packets;
+  ASSERT_EQ(packets.size(), 2u);  // one line each
+  std::vector<std::uint8_t> bad = packets[1];
+  bad[kPacketHeaderBytes] ^= 0xFF;  // other codes
+  bad[kPacketHeaderBytes + 3] |= 0x01;  // and a padding bit set
+  fix_crc(bad);
+  Receiver rx;
+  EXPECT_EQ(rx.push(packets[0]), PushResult::Accepted);
+  EXPECT_EQ(rx.push(bad), PushResult::Malformed);
+  rx.flush();
+  std::vector<ReceivedFrame> frames = rx.take_frames();
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames[0].line_intact, (std::vector<std::uint8_t>{1, 0}));
+  EXPECT_EQ(frames[0].codes.at<cv::Vec3w>(0, 0), cv::Vec3w(1, 2, 3));
+  EXPECT_EQ(frames[0].codes.at<cv::Vec3w>(1, 0), cv::Vec3w(0, 0, 0)) << "the lost line is zeroed, not half written";
+
+  Receiver again;  // the good packet after the bad one completes the view
+  EXPECT_EQ(again.push(packets[0]), PushResult::Accepted);
+  EXPECT_EQ(again.push(bad), PushResult::Malformed);
+  EXPECT_EQ(again.push(packets[1]), PushResult::Accepted);
+  again.flush();
+  frames = again.take_frames();
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_TRUE(frames[0].complete());
+  EXPECT_EQ(cv::norm(frames[0].codes, f.codes, cv::NORM_INF), 0.0);
 }
 
 }  // namespace

@@ -17,7 +17,7 @@ std::uint32_t u32_at(const std::vector<std::uint8_t>& p, std::size_t at) {
 
 TEST(RigProtocol, Crc32IsZlibsIeeeCrc) {
   const char* check = "123456789";  // the standard CRC-32 check value
-  EXPECT_EQ(crc32_of(std::span(reinterpret_cast<const std::uint8_t*>(check), 9)), 0xCBF43926u);
+  EXPECT_EQ(crc32_ieee(std::span(reinterpret_cast<const std::uint8_t*>(check), 9)), 0xCBF43926u);
 }
 
 TEST(RigProtocol, FrameStartLayoutByteByByte) {
@@ -45,8 +45,8 @@ TEST(RigProtocol, FrameStartLayoutByteByByte) {
   EXPECT_EQ(p[47], 0);
   EXPECT_EQ(u32_at(p, 48), 36u);  // 3 x 2 pixels x 3 channels x 2 bytes
   EXPECT_EQ(u32_at(p, 52), 1u);
-  EXPECT_EQ(u32_at(p, 56), crc32_of(pack_samples(f)));
-  EXPECT_EQ(u32_at(p, 60), crc32_of(std::span(p).first(60)));
+  EXPECT_EQ(u32_at(p, 56), crc32_ieee(pack_samples(f)));
+  EXPECT_EQ(u32_at(p, 60), crc32_ieee(std::span(p).first(60)));
   const FrameStart s = decode_frame_start(p);
   EXPECT_EQ(s.frame_index, 0x0102030405060708LL);
   EXPECT_EQ(s.flags, kFlagAnswerExpected);
@@ -72,11 +72,15 @@ TEST(RigProtocol, CodesAboveTheBitDepthAreRefusedWherever) {
     const auto top = static_cast<std::uint16_t>((1u << bits) - 1u);
     std::fill(f.samples.begin(), f.samples.end(), top);
     EXPECT_NO_THROW(f.validate()) << bits << " bits, every code at the top";
+    EXPECT_NO_THROW(encode_frame(f, 64, false)) << bits << " bits, every code at the top";
     for (int bit = bits; bit < 16; ++bit) {
       for (std::size_t at : {std::size_t{0}, std::size_t{31}, std::size_t{64}, f.samples.size() - 1}) {
         RigFrame over = f;
         over.samples[at] = static_cast<std::uint16_t>(over.samples[at] | (1u << bit));
         EXPECT_THROW(over.validate(), std::invalid_argument) << bits << " bits, bit " << bit << " set at " << at;
+        // Packing checks the codes as it goes (encode_frame runs no validate() pass of its own).
+        EXPECT_THROW(pack_samples(over), std::invalid_argument) << bits << " bits, bit " << bit << " set at " << at;
+        EXPECT_THROW(encode_frame(over, 64, false), std::invalid_argument) << bits << " bits, bit " << bit;
       }
     }
   }
@@ -97,8 +101,8 @@ TEST(RigProtocol, ChunkAndEndLayout) {
   EXPECT_EQ(end[0], 0x03);
   EXPECT_EQ(u32_at(end, 4), 2u);
   EXPECT_EQ(u32_at(end, 8), 9u);
-  EXPECT_EQ(u32_at(end, 16), crc32_of(e.payload));
-  EXPECT_EQ(u32_at(end, 20), crc32_of(std::span(end).first(20)));
+  EXPECT_EQ(u32_at(end, 16), crc32_ieee(e.payload));
+  EXPECT_EQ(u32_at(end, 20), crc32_ieee(std::span(end).first(20)));
 }
 
 TEST(RigProtocol, RoundTripsThroughTheReferenceReceiverForAwkwardSizes) {

@@ -1,10 +1,15 @@
 // The whole pipeline over a faulty link: the run completes, the counters add up, and with an OLED panel every
 // frame pair that arrives intact decodes to exactly the bits of a fault-free run.
+#include "capture_replay.hpp"
 #include "pipeline.hpp"
+
+#include "trm/capture.hpp"
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <map>
+#include <unistd.h>
 #include <utility>
 #include <vector>
 
@@ -100,6 +105,49 @@ INSTANTIATE_TEST_SUITE_P(Faults, LinkRecovery,
                                            FaultCase{1e-3, 0.0, false, 6, 4, 200},
                                            FaultCase{1e-3, 0.0, true, 6, 4, 300}, FaultCase{0.0, 0.05, false, 16, 12, 60},
                                            FaultCase{0.0, 0.02, true}, FaultCase{1e-5, 0.01, true}));
+
+// Replay reads the capture on a thread of its own, a view ahead of the decoder: the views still come out in link
+// order with the run's bits, and a capture cut short hands on every view before the cut before its error.
+TEST(Link, CaptureReplayReadAheadKeepsOrderBitsAndErrorsInPlace) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("trm-replay-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  PipelineOptions options = small_run(true, 32, 24, 8);
+  options.impl = "fixed";
+  options.capture_out = (dir / "run.trmcap").string();
+  const Records sent = run(options);
+  ASSERT_EQ(sent.size(), 16u);
+
+  PipelineOptions replay = small_run(true, 32, 24, 8);
+  replay.impl = "fixed";
+  std::vector<std::pair<std::int64_t, int>> order;
+  const CaptureDecodeResult whole = decode_capture_stream(
+      replay, options.capture_out,
+      [&](const FrameMeta& meta, SlotOutcome outcome, const link::ReceivedFrame*, const DecodedFrame& decoded) {
+        EXPECT_EQ(outcome, SlotOutcome::Arrived);
+        order.emplace_back(meta.index, meta.eye);
+        EXPECT_EQ(cv::norm(decoded.drive_codes, sent.at({meta.index, meta.eye}).codes, cv::NORM_INF), 0.0)
+            << "t = " << meta.index << ", eye " << meta.eye;
+      });
+  EXPECT_EQ(whole.views, 16);
+  ASSERT_EQ(order.size(), 16u);
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    EXPECT_EQ(order[i], std::make_pair(static_cast<std::int64_t>(i / 2), static_cast<int>(i % 2)));
+  }
+
+  const fs::path cut = dir / "cut.trmcap";
+  fs::copy_file(options.capture_out, cut);
+  fs::resize_file(cut, fs::file_size(cut) * 5 / 8);  // inside link frame 4 or 5 of 8
+  std::vector<std::pair<std::int64_t, int>> before_cut;
+  EXPECT_THROW(decode_capture_stream(replay, cut.string(),
+                                     [&](const FrameMeta& meta, SlotOutcome, const link::ReceivedFrame*,
+                                         const DecodedFrame&) { before_cut.emplace_back(meta.index, meta.eye); }),
+               link::CaptureError);
+  EXPECT_GE(before_cut.size(), 6u) << "the views read before the cut are handed on before the error";
+  EXPECT_LT(before_cut.size(), 16u);
+  for (std::size_t i = 0; i < before_cut.size(); ++i) EXPECT_EQ(before_cut[i], order[i]);
+  fs::remove_all(dir);
+}
 
 TEST(Link, PayloadPerPairIsExactAndStereoIsFlat) {
   for (bool stereo : {false, true}) {

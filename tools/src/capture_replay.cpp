@@ -4,10 +4,84 @@
 
 #include <nlohmann/json.hpp>
 
+#include <condition_variable>
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <thread>
+
+#include <pthread.h>
 
 namespace trm::cli {
+
+namespace {
+
+// Reads a capture one view ahead of the decoder, on a thread of its own: the file reads, the packets' CRCs and the
+// receiver's assembly of view t+1 then run while view t is decoded instead of before it.
+class ReadAhead {
+ public:
+  explicit ReadAhead(link::CaptureReplay& replay) : replay_(replay), thread_([this] { run(); }) {}
+  ReadAhead(const ReadAhead&) = delete;
+  ReadAhead& operator=(const ReadAhead&) = delete;
+  ~ReadAhead() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+  }
+
+  // The next view, nullopt at the end of the capture; rethrows what reading it threw.
+  std::optional<link::ReceivedFrame> next() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return ready_; });
+    if (failure_) std::rethrow_exception(failure_);
+    std::optional<link::ReceivedFrame> view = std::move(view_);
+    view_.reset();
+    ready_ = false;
+    changed_.notify_all();
+    return view;
+  }
+
+  // The receiver's counters, once next() has returned nullopt.
+  link::ReceiverCounters counters() const { return replay_.counters(); }
+
+ private:
+  void run() {
+    pthread_setname_np(pthread_self(), "trm-read");  // in top -H and perf
+    for (;;) {
+      std::optional<link::ReceivedFrame> view;
+      std::exception_ptr failure;
+      try {
+        view = replay_.next_frame();
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return !ready_ || stopping_; });
+      if (stopping_) return;
+      const bool last = !view || failure;
+      view_ = std::move(view);
+      failure_ = failure;
+      ready_ = true;
+      changed_.notify_all();
+      if (last) return;
+    }
+  }
+
+  link::CaptureReplay& replay_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::optional<link::ReceivedFrame> view_;
+  std::exception_ptr failure_;
+  bool ready_ = false;     // view_ / failure_ hold the next result, not yet taken
+  bool stopping_ = false;
+  std::thread thread_;     // last: started once everything it reads exists
+};
+
+}  // namespace
 
 std::string capture_metadata(const PipelineOptions& options, std::int64_t frames) {
   nlohmann::ordered_json meta = encoder_json(options.encoder);
@@ -84,7 +158,8 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
       sink(lost, SlotOutcome::Lost, nullptr, display->show_lost(lost));
     }
   };
-  while (auto received = replay.next_frame()) {
+  ReadAhead reader(replay);
+  while (auto received = reader.next()) {
     const FrameMeta& m = received->meta;
     const std::string view = "view t=" + std::to_string(m.index) + " eye " + std::to_string(m.eye);
     if (m.eye >= eyes) {
@@ -122,7 +197,7 @@ CaptureDecodeResult decode_capture_stream(const PipelineOptions& options, const 
     throw std::runtime_error(where + "its header says stereo, but no view of eye 1 (stream 1) arrived: a mono stream");
   }
   if (frames_sent) hand_on_views_before(*frames_sent * eyes);
-  result.receiver = replay.counters();
+  result.receiver = reader.counters();
   return result;
 }
 

@@ -17,13 +17,21 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <exception>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <sstream>
+#include <thread>
+
+#include <pthread.h>
 
 namespace trm::cli {
 namespace {
@@ -157,6 +165,10 @@ rig::RigFrame to_rig_frame(const DecodedFrame& decoded, int bits) {
   f.width = codes.cols;
   f.height = codes.rows;
   f.bits = bits;
+  if (codes.isContinuous()) {
+    f.samples.assign(codes.ptr<std::uint16_t>(), codes.ptr<std::uint16_t>() + codes.total() * 3u);
+    return f;
+  }
   f.samples.reserve(static_cast<std::size_t>(codes.cols) * static_cast<std::size_t>(codes.rows) * 3u);
   for (int y = 0; y < codes.rows; ++y) {
     const auto* row = codes.ptr<std::uint16_t>(y);
@@ -164,6 +176,79 @@ rig::RigFrame to_rig_frame(const DecodedFrame& decoded, int bits) {
   }
   return f;
 }
+
+// Sends each view on a thread of its own while the next one is read and decoded, one view in flight: what the feed
+// does per view besides decoding (the rig frame's packing, range check and CRC, the transport's writes) then no
+// longer adds to the decoder's time on the main thread, which at 90 Hz leaves no room for it. The view is held by
+// reference (its planes are shared, not copied): a decoder never writes into a plane a caller still holds.
+class SendingThread {
+ public:
+  explicit SendingThread(std::function<void(const DecodedFrame&)> send) : send_(std::move(send)), thread_([this] { run(); }) {}
+  SendingThread(const SendingThread&) = delete;
+  SendingThread& operator=(const SendingThread&) = delete;
+  ~SendingThread() { stop(); }
+
+  // Waits until the view before has been sent, rethrowing what sending it threw, then hands this one over.
+  void submit(const DecodedFrame& view) {
+    std::unique_lock lock(mutex_);
+    idle_.wait(lock, [&] { return !pending_; });
+    rethrow_failure(lock);
+    pending_ = view;
+    ready_.notify_one();
+  }
+
+  // Waits until the last view has been sent; rethrows what sending it threw.
+  void finish() {
+    std::unique_lock lock(mutex_);
+    idle_.wait(lock, [&] { return !pending_; });
+    rethrow_failure(lock);
+  }
+
+ private:
+  void run() {
+    pthread_setname_np(pthread_self(), "trm-send");  // in top -H and perf
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      ready_.wait(lock, [&] { return pending_.has_value() || stopping_; });
+      if (!pending_) return;
+      lock.unlock();
+      // pending_ stays set while it is sent: submit() waits for it and nothing else writes it.
+      std::exception_ptr failure;
+      try {
+        send_(*pending_);
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      lock.lock();
+      pending_.reset();  // before the decoder is let go, so that it finds the view's planes free to reuse
+      if (failure && !failure_) failure_ = failure;
+      idle_.notify_all();
+    }
+  }
+
+  void rethrow_failure(std::unique_lock<std::mutex>&) {
+    if (!failure_) return;
+    std::exception_ptr failure = std::exchange(failure_, nullptr);
+    std::rethrow_exception(failure);
+  }
+
+  void stop() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    ready_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  std::function<void(const DecodedFrame&)> send_;
+  std::mutex mutex_;
+  std::condition_variable ready_, idle_;
+  std::optional<DecodedFrame> pending_;
+  std::exception_ptr failure_;
+  bool stopping_ = false;
+  std::thread thread_;  // last: started once everything it reads exists
+};
 
 int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
   PipelineOptions pipeline = options_given;
@@ -227,7 +312,7 @@ int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
   bool warned = false;
   int exit_code = 0;
   try {
-    const auto feed_decoded = [&](const DecodedFrame& decoded) {
+    const auto send_view = [&](const DecodedFrame& decoded) {
       rig::RigFrame frame = to_rig_frame(decoded, pipeline.output_bits);
       if (roi || s.downscale > 1)
         frame = rig::crop_and_decimate(frame, roi.value_or(rig::Region{0, 0, frame.width, frame.height}), s.downscale);
@@ -237,14 +322,16 @@ int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
       }
       feeder.feed(frame);
     };
+    SendingThread sender(send_view);
     if (!s.capture.empty()) {
       decode_capture_stream(pipeline, s.capture,
                             [&](const FrameMeta&, SlotOutcome, const link::ReceivedFrame*, const DecodedFrame& decoded) {
-                              feed_decoded(decoded);
+                              sender.submit(decoded);
                             });
     } else {
-      run_pipeline(pipeline, [&](const DecodedView& view) { feed_decoded(*view.decoded); });
+      run_pipeline(pipeline, [&](const DecodedView& view) { sender.submit(*view.decoded); });
     }
+    sender.finish();
     transport->finish();
     summary["status"] = "ok";
   } catch (const rig::RigError& e) {
@@ -262,6 +349,9 @@ void register_feed(CLI::App& app, Action& action) {
                                          "(protocol: docs/rig_protocol.md)");
   auto settings = std::make_shared<FeedSettings>();
   auto pipeline = std::make_shared<PipelineOptions>();
+  // A rig is fed what the hardware would show, at the panel's pace: the hardware model on every core by default.
+  pipeline->impl = "fixed";
+  pipeline->threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxDecoderThreads);
   pipeline->add_options(*cmd);
   pipeline->add_method_option(*cmd);
   FeedSettings& s = *settings;

@@ -67,12 +67,15 @@ class CaptureReader {
   const std::string& metadata() const { return metadata_; }
   // The next packet, or nullopt after a valid end record.
   std::optional<std::vector<std::uint8_t>> next_packet();
+  // The same into `packet` (its memory reused from call to call); false after a valid end record.
+  bool next_packet(std::vector<std::uint8_t>& packet);
   std::uint64_t packets_read() const { return packets_; }
 
  private:
   void read_exact(void* destination, std::uint64_t count, const char* what);
   void read_header();
 
+  std::vector<char> read_buffer_;  // the file stream's buffer: declared first, so that it outlives the stream
   std::unique_ptr<std::istream> in_;
   std::string name_;          // for messages
   std::uint64_t size_ = 0;    // total bytes

@@ -63,6 +63,7 @@ class CaptureReplay {
 
  private:
   CaptureReader reader_;
+  std::vector<std::uint8_t> packet_;  // the packet being pushed, its memory reused
   Receiver receiver_;
   std::vector<ReceivedFrame> pending_;
   std::size_t next_pending_ = 0;

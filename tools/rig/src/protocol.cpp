@@ -1,6 +1,5 @@
 #include "rig/protocol.hpp"
 
-#include <zlib.h>
 
 #include <algorithm>
 #include <cstring>
@@ -69,19 +68,32 @@ std::size_t RigFrame::payload_size() const {
          static_cast<std::size_t>(bytes_per_sample());
 }
 
-void RigFrame::validate() const {
-  if (width <= 0 || height <= 0) throw std::invalid_argument("rig frame: width and height must be positive");
-  if (bits < 1 || bits > 16) throw std::invalid_argument("rig frame: bits per channel must be 1..16");
-  if (eye < 0 || eye > 255) throw std::invalid_argument("rig frame: eye must be 0..255");
-  if (step < 1 || step > 0xFFFF) throw std::invalid_argument("rig frame: step must be 1..65535");
-  if (samples.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3u)
+namespace {
+
+// Everything validate() checks but the codes themselves.
+void check_layout(const RigFrame& f) {
+  if (f.width <= 0 || f.height <= 0) throw std::invalid_argument("rig frame: width and height must be positive");
+  if (f.bits < 1 || f.bits > 16) throw std::invalid_argument("rig frame: bits per channel must be 1..16");
+  if (f.eye < 0 || f.eye > 255) throw std::invalid_argument("rig frame: eye must be 0..255");
+  if (f.step < 1 || f.step > 0xFFFF) throw std::invalid_argument("rig frame: step must be 1..65535");
+  if (f.samples.size() != static_cast<std::size_t>(f.width) * static_cast<std::size_t>(f.height) * 3u)
     throw std::invalid_argument("rig frame: sample count is not width * height * 3");
-  // max_code is 2^bits - 1, so a code exceeds it exactly when it has a bit above it: one OR over the frame (a loop
-  // without an early exit, which the compiler vectorises) instead of a comparison and branch per sample.
+}
+
+// max_code is 2^bits - 1, so a code exceeds it exactly when it has a bit above it: one OR over the frame (a loop
+// without an early exit, which the compiler vectorises) instead of a comparison and branch per sample.
+void check_codes(std::uint16_t any_bits, int bits) {
   const auto max_code = static_cast<std::uint16_t>((1u << bits) - 1u);
+  if ((any_bits & ~max_code) != 0) throw std::invalid_argument("rig frame: a drive code exceeds its bit depth");
+}
+
+}  // namespace
+
+void RigFrame::validate() const {
+  check_layout(*this);
   std::uint16_t any_bits = 0;
   for (const std::uint16_t s : samples) any_bits |= s;
-  if ((any_bits & ~max_code) != 0) throw std::invalid_argument("rig frame: a drive code exceeds its bit depth");
+  check_codes(any_bits, bits);
 }
 
 RigFrame crop_and_decimate(const RigFrame& view, const Region& region, int step) {
@@ -123,32 +135,28 @@ const char* describe_rig_error_code(std::uint8_t code) {
   }
 }
 
-std::uint32_t crc32_of(std::span<const std::uint8_t> bytes) {
-  uLong crc = crc32(0L, Z_NULL, 0);
-  // zlib takes uInt lengths: feed large buffers in pieces.
-  std::size_t offset = 0;
-  while (offset < bytes.size()) {
-    const std::size_t n = std::min<std::size_t>(bytes.size() - offset, 1u << 30);
-    crc = crc32(crc, bytes.data() + offset, static_cast<uInt>(n));
-    offset += n;
-  }
-  return static_cast<std::uint32_t>(crc);
-}
-
 std::vector<std::uint8_t> pack_samples(const RigFrame& frame) {
+  check_layout(frame);
   std::vector<std::uint8_t> out(frame.payload_size());
   // Through local restrict pointers: a uint8_t store may alias anything, which otherwise keeps these loops scalar.
+  // The codes are checked against the bit depth in the same pass (validate()'s check without a pass of its own).
   const std::uint16_t* __restrict in = frame.samples.data();
   std::uint8_t* __restrict bytes = out.data();
   const std::size_t n = frame.samples.size();
+  std::uint16_t any_bits = 0;
   if (frame.bytes_per_sample() == 1) {
-    for (std::size_t i = 0; i < n; ++i) bytes[i] = static_cast<std::uint8_t>(in[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      any_bits |= in[i];
+      bytes[i] = static_cast<std::uint8_t>(in[i]);
+    }
   } else {
     for (std::size_t i = 0; i < n; ++i) {  // little endian, as put_u16
+      any_bits |= in[i];
       bytes[2 * i] = static_cast<std::uint8_t>(in[i]);
       bytes[2 * i + 1] = static_cast<std::uint8_t>(in[i] >> 8);
     }
   }
+  check_codes(any_bits, frame.bits);
   return out;
 }
 
@@ -175,7 +183,7 @@ std::vector<std::uint8_t> encode_frame_start(const FrameStart& s) {
   put_u32(&p[48], s.payload_length);
   put_u32(&p[52], s.chunk_count);
   put_u32(&p[56], s.payload_crc);
-  put_u32(&p[60], crc32_of(std::span(p).first(60)));
+  put_u32(&p[60], crc32_ieee(std::span(p).first(60)));
   return p;
 }
 
@@ -196,7 +204,7 @@ std::vector<std::uint8_t> encode_frame_end(const FrameEnd& e) {
   put_u32(&p[4], e.chunk_count);
   put_i64(&p[8], e.frame_index);
   put_u32(&p[16], e.payload_crc);
-  put_u32(&p[20], crc32_of(std::span(p).first(20)));
+  put_u32(&p[20], crc32_ieee(std::span(p).first(20)));
   return p;
 }
 
@@ -213,7 +221,7 @@ FrameStart decode_frame_start(std::span<const std::uint8_t> p) {
   if (p.size() < kFrameStartSize) malformed("FRAME_START shorter than 64 bytes");
   if (p[0] != static_cast<std::uint8_t>(PacketType::FrameStart)) malformed("not a FRAME_START packet");
   if (!std::equal(kStartMagic.begin(), kStartMagic.end(), p.begin() + 1)) malformed("bad FRAME_START magic");
-  if (get_u32(&p[60]) != crc32_of(p.first(60))) malformed("FRAME_START header CRC mismatch");
+  if (get_u32(&p[60]) != crc32_ieee(p.first(60))) malformed("FRAME_START header CRC mismatch");
   FrameStart s;
   s.version = p[4];
   if (s.version != kProtocolVersion) malformed("unsupported protocol version " + std::to_string(s.version));
@@ -249,7 +257,7 @@ ChunkHeader decode_chunk_header(std::span<const std::uint8_t> p) {
 
 FrameEnd decode_frame_end(std::span<const std::uint8_t> p) {
   if (p.size() < kFrameEndSize || p[0] != static_cast<std::uint8_t>(PacketType::FrameEnd)) malformed("not a FRAME_END packet");
-  if (get_u32(&p[20]) != crc32_of(p.first(20))) malformed("FRAME_END CRC mismatch");
+  if (get_u32(&p[20]) != crc32_ieee(p.first(20))) malformed("FRAME_END CRC mismatch");
   return FrameEnd{get_u32(&p[4]), get_i64(&p[8]), get_u32(&p[16])};
 }
 
@@ -298,7 +306,7 @@ std::size_t EncodedFrame::wire_size() const {
 }
 
 EncodedFrame encode_frame(const RigFrame& frame, std::size_t max_packet_size, bool answer_expected) {
-  frame.validate();
+  check_layout(frame);  // the codes are checked as they are packed
   if (max_packet_size < kMinPacketSize)
     throw std::invalid_argument("transport packets of " + std::to_string(max_packet_size) +
                                 " bytes cannot carry a 64-byte FRAME_START");
@@ -321,7 +329,7 @@ EncodedFrame encode_frame(const RigFrame& frame, std::size_t max_packet_size, bo
   s.step = static_cast<std::uint16_t>(frame.step);
   s.payload_length = checked_u32(e.payload.size(), "frame payload");
   s.chunk_count = checked_u32((e.payload.size() + e.chunk_data_size - 1) / e.chunk_data_size, "chunk count");
-  s.payload_crc = crc32_of(e.payload);
+  s.payload_crc = crc32_ieee(e.payload);
   e.start_packet = encode_frame_start(s);
   e.end_packet = encode_frame_end(FrameEnd{s.chunk_count, s.frame_index, s.payload_crc});
   return e;
@@ -362,7 +370,7 @@ void StreamReceiver::accept_packet(std::span<const std::uint8_t> packet) {
       if (e.frame_index != open_->frame_index || e.chunk_count != open_->chunk_count || next_sequence_ != e.chunk_count)
         malformed("FRAME_END does not match the open frame");
       if (payload_.size() != open_->payload_length) malformed("payload length mismatch");
-      if (crc32_of(payload_) != open_->payload_crc || e.payload_crc != open_->payload_crc) malformed("payload CRC mismatch");
+      if (crc32_ieee(payload_) != open_->payload_crc || e.payload_crc != open_->payload_crc) malformed("payload CRC mismatch");
       RigFrame f;
       f.index = open_->frame_index;
       f.eye = open_->eye;

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "trm/crc32.hpp"
+
 namespace trm::rig {
 
 inline constexpr std::uint8_t kProtocolVersion = 1;
@@ -105,10 +107,10 @@ struct Answer {
 };
 const char* describe_rig_error_code(std::uint8_t code);
 
-// zlib crc32 (IEEE 802.3, the same as PNG and Ethernet).
-std::uint32_t crc32_of(std::span<const std::uint8_t> bytes);
+// The protocol's CRC-32 (IEEE 802.3, the same as zlib, PNG and Ethernet) is trm::crc32_ieee.
+using trm::crc32_ieee;
 
-// Payload bytes of a frame in wire order.
+// Payload bytes of a frame in wire order; throws std::invalid_argument where RigFrame::validate() would.
 std::vector<std::uint8_t> pack_samples(const RigFrame& frame);
 
 std::vector<std::uint8_t> encode_frame_start(const FrameStart& start);
