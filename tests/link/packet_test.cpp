@@ -1,12 +1,14 @@
 // Packet format: byte layout, CRC, and that the parser trusts no field.
 #include "trm/link.hpp"
 #include "trm/packet.hpp"
+#include "trm/crc32.hpp"
 
 #include "link_test_support.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <random>
 #include <functional>
 
 namespace trm::link {
@@ -54,6 +56,28 @@ TEST(Packet, CrcIsTheStandardCrc32) {
   // The check value of CRC-32/ISO-HDLC (zlib, IEEE 802.3) over "123456789" is 0xCBF43926.
   std::vector<std::uint8_t> bytes = {'1', '2', '3', '4', '5', '6', '7', '8', '9', 0, 0, 0, 0};
   EXPECT_EQ(packet_crc(bytes), 0xCBF43926u);
+}
+
+// The library's carry-less-multiply CRC against the definition computed a bit at a time, at every length up to 600
+// bytes (its short and tail paths) and at large lengths from every alignment (its folding loops).
+TEST(Packet, Crc32EqualsTheBitwiseDefinitionAtEveryLengthAndAlignment) {
+  const auto bitwise = [](std::span<const std::uint8_t> bytes) {
+    std::uint32_t crc = 0xFFFFFFFFu;
+    for (const std::uint8_t b : bytes) {
+      crc ^= b;
+      for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return ~crc;
+  };
+  std::mt19937 rng(11);
+  std::vector<std::uint8_t> bytes(70000);
+  for (auto& b : bytes) b = static_cast<std::uint8_t>(rng());
+  const std::span<const std::uint8_t> all(bytes);
+  for (std::size_t n = 0; n <= 600; ++n) EXPECT_EQ(crc32_ieee(all.first(n)), bitwise(all.first(n))) << n << " bytes";
+  for (std::size_t offset = 0; offset < 64; ++offset) {
+    const std::size_t n = 65537 + offset * 13;
+    EXPECT_EQ(crc32_ieee(all.subspan(offset, n)), bitwise(all.subspan(offset, n))) << n << " bytes at " << offset;
+  }
 }
 
 TEST(Packet, ByteLayoutIsLittleEndianAsDocumented) {
