@@ -61,6 +61,40 @@ TEST(RigFeeder, DropsFramesWhoseSlotHasPassed) {
   EXPECT_EQ(feed_all(unhurried, frames, options).frames_dropped, 0);
 }
 
+// A source whose first two frames come late (a decoder's start-up): without a pre-roll the run starts behind its
+// slots and drops; with one, those frames go out as they come and the pace starts with the third.
+TEST(RigFeeder, PreRolledFramesGoOutBeforeThePaceStarts) {
+  std::vector<RigFrame> frames;
+  for (int i = 0; i < 8; ++i) frames.push_back(synthetic_frame(i, 0, 4, 4, 8));
+  const auto feed_with_slow_start = [&](int preroll, std::chrono::steady_clock::duration* paced_part) {
+    MemoryTransport transport;
+    FeedOptions options;
+    options.fps = 50.0;  // 20 ms slots: room for a loaded machine
+    options.preroll_frames = preroll;
+    RigFeeder feeder(transport, options);
+    std::chrono::steady_clock::time_point third;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      if (i == 1) std::this_thread::sleep_for(90ms);  // frame 1 comes 4.5 slots after frame 0
+      if (i == 2) third = std::chrono::steady_clock::now();
+      feeder.feed(frames[i]);
+    }
+    if (paced_part) *paced_part = std::chrono::steady_clock::now() - third;
+    EXPECT_EQ(static_cast<std::int64_t>(receive_stream(transport.bytes).size()), feeder.stats().frames_sent);
+    return feeder.stats();
+  };
+  const FeedStats behind = feed_with_slow_start(0, nullptr);
+  EXPECT_GE(behind.frames_dropped, 1) << "frame 1 came after its slot closed";
+  std::chrono::steady_clock::duration paced{};
+  const FeedStats rolled = feed_with_slow_start(2, &paced);
+  EXPECT_EQ(rolled.frames_dropped, 0);
+  EXPECT_EQ(rolled.frames_sent, 8);
+  EXPECT_GE(paced, 100ms) << "frames 2..7 are paced: their slots open at 0, 20, ..., 100 ms";
+  MemoryTransport unused;
+  FeedOptions negative;
+  negative.preroll_frames = -1;
+  EXPECT_THROW(RigFeeder(unused, negative), std::invalid_argument);
+}
+
 TEST(RigFeeder, SummaryAndProgressLine) {
   MemoryTransport transport;
   FeedOptions options;

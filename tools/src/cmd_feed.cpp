@@ -57,6 +57,7 @@ struct FeedSettings {
   // pacing and flow control
   double fps = -1.0;  // < 0: the panel refresh
   bool no_drop = false;
+  int preroll = 2;  // views sent before the pace starts: the decoder's first pair touches its memory for the first time
   bool flow_control = false;
   int answer_timeout_ms = 2000;
   int max_resends = 3;
@@ -301,6 +302,7 @@ int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
   rig::FeedOptions options;
   options.fps = s.fps < 0 ? pipeline.refresh_hz : s.fps;
   options.drop_late = !s.no_drop;
+  options.preroll_frames = s.preroll;
   options.flow_control = s.flow_control;
   options.answer_timeout = std::chrono::milliseconds(s.answer_timeout_ms);
   options.max_resends_per_frame = s.max_resends;
@@ -383,6 +385,10 @@ void register_feed(CLI::App& app, Action& action) {
   cmd->add_option("--fps", s.fps, "Views per second (default: the panel refresh, --refresh; 0: as fast as possible)")
       ->check(finite_non_negative(" (0: as fast as possible; leave --fps out for the panel refresh)"));
   cmd->add_flag("--no-drop", s.no_drop, "Paced: send late views anyway instead of dropping them");
+  cmd->add_option("--preroll", s.preroll,
+                  "Paced: views sent as soon as they are decoded before the pace starts (the decoder's first pair "
+                  "touches its frame stores for the first time)")
+      ->capture_default_str()->check(CLI::Range(0, 1000000));
   cmd->add_flag("--flow-control", s.flow_control, "Wait for the rig's READY / RESEND / ERROR after every view");
   cmd->add_option("--answer-timeout", s.answer_timeout_ms, "Flow control: ms to wait for an answer")->capture_default_str()->check(CLI::Range(1, 600000));
   cmd->add_option("--max-resends", s.max_resends, "Flow control: RESEND answers honoured per view")->capture_default_str()->check(CLI::Range(0, 1000));

@@ -39,6 +39,7 @@ nlohmann::json FeedStats::to_json() const {
 
 RigFeeder::RigFeeder(RigTransport& transport, FeedOptions options) : transport_(transport), options_(std::move(options)) {
   if (options_.fps < 0 || !std::isfinite(options_.fps)) throw std::invalid_argument("--fps must be >= 0");
+  if (options_.preroll_frames < 0) throw std::invalid_argument("--preroll must be >= 0");
   if (options_.flow_control && !transport_.can_receive())
     throw std::invalid_argument("flow control needs a transport the rig can answer on (bulk IN endpoint or HID input reports): " +
                                 transport_.description());
@@ -132,13 +133,16 @@ bool RigFeeder::feed(const RigFrame& frame) {
     started_ = last_progress_ = Clock::now();
     started_clock_ = true;
   }
-  const std::int64_t slot = stats_.frames_offered++;
-  if (options_.fps > 0) {
-    // Slot k opens at t0 + k / fps; a frame whose slot has closed is dropped to keep real time.
-    const auto period = std::chrono::duration<double>(1.0 / options_.fps);
-    const auto opens = started_ + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(slot));
-    const auto closes = started_ + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(slot + 1));
+  const std::int64_t offered = stats_.frames_offered++;
+  if (options_.fps > 0 && offered >= options_.preroll_frames) {
+    // Slot k opens at t0 + k / fps, t0 when the first frame after the pre-roll came; a frame whose slot has closed
+    // is dropped to keep real time.
+    const std::int64_t slot = offered - options_.preroll_frames;
     const auto now = Clock::now();
+    if (slot == 0) paced_from_ = now;
+    const auto period = std::chrono::duration<double>(1.0 / options_.fps);
+    const auto opens = paced_from_ + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(slot));
+    const auto closes = paced_from_ + std::chrono::duration_cast<Clock::duration>(period * static_cast<double>(slot + 1));
     if (options_.drop_late && slot > 0 && now >= closes) {
       ++stats_.frames_dropped;
       tick(true);

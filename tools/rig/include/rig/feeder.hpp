@@ -35,6 +35,9 @@ struct FeedStats {
 struct FeedOptions {
   double fps = 0.0;               // frame slots per second; 0: as fast as the transport goes
   bool drop_late = true;          // paced: skip a frame whose slot has already passed
+  // Paced: frames sent as soon as they come before the pace starts with the next one, so that a source's start-up
+  // (a decoder touching its frame stores for the first time) does not leave the whole run behind its slots.
+  int preroll_frames = 0;
   bool flow_control = false;      // wait for READY / RESEND / ERROR after every frame
   std::chrono::milliseconds answer_timeout{2000};
   int max_resends_per_frame = 3;
@@ -65,6 +68,7 @@ class RigFeeder {
   FeedStats stats_;
   std::chrono::steady_clock::time_point started_;
   std::chrono::steady_clock::time_point last_progress_;
+  std::chrono::steady_clock::time_point paced_from_;  // when the first frame after the pre-roll was offered
   bool started_clock_ = false;
 };
 
