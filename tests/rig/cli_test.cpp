@@ -55,6 +55,29 @@ TEST(TrmFeed, FileOutputOfASceneIsByteIdenticalToWhatTheUsbRigReceived) {
   EXPECT_EQ(report["stats"]["wire_bytes_sent"], written.size());
 }
 
+// Whole views are packed in place from the decoder's output plane; a region is copied out first. The
+// codes that arrive must not depend on which of the two paths carried them.
+TEST(TrmFeed, ViewsPackedInPlaceCarryTheSameCodesAsTheCopiedWholeRegion) {
+  const std::string whole = temp_path("whole.bin"), region = temp_path("region.bin");
+  ASSERT_EQ(run_trm("feed --file " + whole + kScene), 0);
+  ASSERT_EQ(run_trm("feed --file " + region + kScene + " --roi 0,0,40,30"), 0);
+  const auto in_place = receive_stream(slurp(whole));
+  const auto copied = receive_stream(slurp(region));
+  ::unlink(whole.c_str());
+  ::unlink(region.c_str());
+  ASSERT_EQ(in_place.size(), 3u);
+  ASSERT_EQ(copied.size(), 3u);
+  for (std::size_t i = 0; i < in_place.size(); ++i) {
+    EXPECT_EQ(in_place[i].index, copied[i].index);
+    EXPECT_EQ(in_place[i].width, copied[i].width);
+    EXPECT_EQ(in_place[i].height, copied[i].height);
+    EXPECT_EQ(in_place[i].samples, copied[i].samples) << "view " << i;
+  }
+  std::uint16_t any_code = 0;
+  for (const std::uint16_t c : in_place[1].samples) any_code |= c;
+  EXPECT_NE(any_code, 0) << "a scene of discs drives some subpixel";
+}
+
 TEST(TrmFeed, UnpluggedRigGivesItsExitCodeAndTheSummarySaysHowFarItGot) {
   RigBehaviour rig;
   rig.fault = Fault::Vanish;

@@ -136,7 +136,7 @@ std::string human_seconds(double seconds) {
 }
 
 // Says up front what the transport can carry, and what to do when a full view does not fit the pace.
-void warn_about_throughput(const rig::RigTransport& transport, const rig::RigFrame& frame, double fps, bool cropped) {
+void warn_about_throughput(const rig::RigTransport& transport, const rig::RigFrameHeader& frame, double fps, bool cropped) {
   const rig::TransportRate rate = transport.nominal_rate();
   if (rate.bytes_per_second <= 0) return;
   const double per_frame = rig::RigFeeder::seconds_per_frame(transport, frame);
@@ -157,19 +157,22 @@ void warn_about_throughput(const rig::RigTransport& transport, const rig::RigFra
   std::cerr << out.str() << "\n";
 }
 
-rig::RigFrame to_rig_frame(const DecodedFrame& decoded, int bits) {
+rig::RigFrameHeader rig_header(const DecodedFrame& decoded, int bits) {
   const cv::Mat& codes = decoded.drive_codes;
   if (codes.type() != CV_16UC3) throw std::runtime_error("feed: decoder drive codes are not CV_16UC3");
+  rig::RigFrameHeader h;
+  h.index = decoded.meta.index;
+  h.eye = decoded.meta.eye;
+  h.width = codes.cols;
+  h.height = codes.rows;
+  h.bits = bits;
+  return h;
+}
+
+rig::RigFrame to_rig_frame(const DecodedFrame& decoded, int bits) {
+  const cv::Mat& codes = decoded.drive_codes;
   rig::RigFrame f;
-  f.index = decoded.meta.index;
-  f.eye = decoded.meta.eye;
-  f.width = codes.cols;
-  f.height = codes.rows;
-  f.bits = bits;
-  if (codes.isContinuous()) {
-    f.samples.assign(codes.ptr<std::uint16_t>(), codes.ptr<std::uint16_t>() + codes.total() * 3u);
-    return f;
-  }
+  static_cast<rig::RigFrameHeader&>(f) = rig_header(decoded, bits);
   f.samples.reserve(static_cast<std::size_t>(codes.cols) * static_cast<std::size_t>(codes.rows) * 3u);
   for (int y = 0; y < codes.rows; ++y) {
     const auto* row = codes.ptr<std::uint16_t>(y);
@@ -314,7 +317,18 @@ int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
   bool warned = false;
   int exit_code = 0;
   try {
+    const bool whole_views = !roi && s.downscale == 1;
     const auto send_view = [&](const DecodedFrame& decoded) {
+      const cv::Mat& codes = decoded.drive_codes;
+      if (whole_views && codes.isContinuous()) {  // packed straight from the decoder's output plane
+        const rig::RigFrameHeader header = rig_header(decoded, pipeline.output_bits);
+        if (!warned) {
+          warn_about_throughput(*transport, header, options.fps, false);
+          warned = true;
+        }
+        feeder.feed(header, std::span(codes.ptr<std::uint16_t>(), codes.total() * 3u));
+        return;
+      }
       rig::RigFrame frame = to_rig_frame(decoded, pipeline.output_bits);
       if (roi || s.downscale > 1)
         frame = rig::crop_and_decimate(frame, roi.value_or(rig::Region{0, 0, frame.width, frame.height}), s.downscale);

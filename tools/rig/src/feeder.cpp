@@ -45,7 +45,7 @@ RigFeeder::RigFeeder(RigTransport& transport, FeedOptions options) : transport_(
                                 transport_.description());
 }
 
-double RigFeeder::seconds_per_frame(const RigTransport& transport, const RigFrame& frame) {
+double RigFeeder::seconds_per_frame(const RigTransport& transport, const RigFrameHeader& frame) {
   const TransportRate rate = transport.nominal_rate();
   if (rate.bytes_per_second <= 0) return 0.0;
   const std::size_t packet = transport.max_packet_size();
@@ -128,7 +128,9 @@ void RigFeeder::await_answer(const EncodedFrame& frame) {
   }
 }
 
-bool RigFeeder::feed(const RigFrame& frame) {
+bool RigFeeder::feed(const RigFrame& frame) { return feed(frame, frame.samples); }
+
+bool RigFeeder::feed(const RigFrameHeader& frame, std::span<const std::uint16_t> samples) {
   if (!started_clock_) {
     started_ = last_progress_ = Clock::now();
     started_clock_ = true;
@@ -151,7 +153,7 @@ bool RigFeeder::feed(const RigFrame& frame) {
     if (now < opens) std::this_thread::sleep_until(opens);
   }
 
-  const EncodedFrame encoded = encode_frame(frame, transport_.max_packet_size(), options_.flow_control);
+  const EncodedFrame encoded = encode_frame(frame, samples, transport_.max_packet_size(), options_.flow_control);
   stats_.interrupted_frame = frame.index;
   stats_.interrupted_chunks_sent = 0;
   stats_.interrupted_chunk_count = encoded.chunk_count();

@@ -63,7 +63,7 @@ std::uint32_t checked_u32(std::size_t v, const char* what) {
 
 }  // namespace
 
-std::size_t RigFrame::payload_size() const {
+std::size_t RigFrameHeader::payload_size() const {
   return static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3u *
          static_cast<std::size_t>(bytes_per_sample());
 }
@@ -71,12 +71,12 @@ std::size_t RigFrame::payload_size() const {
 namespace {
 
 // Everything validate() checks but the codes themselves.
-void check_layout(const RigFrame& f) {
+void check_layout(const RigFrameHeader& f, std::size_t sample_count) {
   if (f.width <= 0 || f.height <= 0) throw std::invalid_argument("rig frame: width and height must be positive");
   if (f.bits < 1 || f.bits > 16) throw std::invalid_argument("rig frame: bits per channel must be 1..16");
   if (f.eye < 0 || f.eye > 255) throw std::invalid_argument("rig frame: eye must be 0..255");
   if (f.step < 1 || f.step > 0xFFFF) throw std::invalid_argument("rig frame: step must be 1..65535");
-  if (f.samples.size() != static_cast<std::size_t>(f.width) * static_cast<std::size_t>(f.height) * 3u)
+  if (sample_count != static_cast<std::size_t>(f.width) * static_cast<std::size_t>(f.height) * 3u)
     throw std::invalid_argument("rig frame: sample count is not width * height * 3");
 }
 
@@ -90,7 +90,7 @@ void check_codes(std::uint16_t any_bits, int bits) {
 }  // namespace
 
 void RigFrame::validate() const {
-  check_layout(*this);
+  check_layout(*this, samples.size());
   std::uint16_t any_bits = 0;
   for (const std::uint16_t s : samples) any_bits |= s;
   check_codes(any_bits, bits);
@@ -135,16 +135,18 @@ const char* describe_rig_error_code(std::uint8_t code) {
   }
 }
 
-std::vector<std::uint8_t> pack_samples(const RigFrame& frame) {
-  check_layout(frame);
-  std::vector<std::uint8_t> out(frame.payload_size());
+std::vector<std::uint8_t> pack_samples(const RigFrame& frame) { return pack_samples(frame, frame.samples); }
+
+std::vector<std::uint8_t> pack_samples(const RigFrameHeader& header, std::span<const std::uint16_t> samples) {
+  check_layout(header, samples.size());
+  std::vector<std::uint8_t> out(header.payload_size());
   // Through local restrict pointers: a uint8_t store may alias anything, which otherwise keeps these loops scalar.
   // The codes are checked against the bit depth in the same pass (validate()'s check without a pass of its own).
-  const std::uint16_t* __restrict in = frame.samples.data();
+  const std::uint16_t* __restrict in = samples.data();
   std::uint8_t* __restrict bytes = out.data();
-  const std::size_t n = frame.samples.size();
+  const std::size_t n = samples.size();
   std::uint16_t any_bits = 0;
-  if (frame.bytes_per_sample() == 1) {
+  if (header.bytes_per_sample() == 1) {
     for (std::size_t i = 0; i < n; ++i) {
       any_bits |= in[i];
       bytes[i] = static_cast<std::uint8_t>(in[i]);
@@ -156,7 +158,7 @@ std::vector<std::uint8_t> pack_samples(const RigFrame& frame) {
       bytes[2 * i + 1] = static_cast<std::uint8_t>(in[i] >> 8);
     }
   }
-  check_codes(any_bits, frame.bits);
+  check_codes(any_bits, header.bits);
   return out;
 }
 
@@ -306,13 +308,18 @@ std::size_t EncodedFrame::wire_size() const {
 }
 
 EncodedFrame encode_frame(const RigFrame& frame, std::size_t max_packet_size, bool answer_expected) {
-  check_layout(frame);  // the codes are checked as they are packed
+  return encode_frame(frame, frame.samples, max_packet_size, answer_expected);
+}
+
+EncodedFrame encode_frame(const RigFrameHeader& frame, std::span<const std::uint16_t> samples, std::size_t max_packet_size,
+                          bool answer_expected) {
+  check_layout(frame, samples.size());  // the codes are checked as they are packed
   if (max_packet_size < kMinPacketSize)
     throw std::invalid_argument("transport packets of " + std::to_string(max_packet_size) +
                                 " bytes cannot carry a 64-byte FRAME_START");
   EncodedFrame e;
   e.chunk_data_size = std::min(max_packet_size - kChunkHeaderSize, kMaxChunkData);
-  e.payload = pack_samples(frame);
+  e.payload = pack_samples(frame, samples);
   FrameStart& s = e.start;
   s.bits = static_cast<std::uint8_t>(frame.bits);
   s.bytes_per_sample = static_cast<std::uint8_t>(frame.bytes_per_sample());

@@ -52,10 +52,12 @@ class RigFeeder {
   // Sends one frame (or drops it when its slot has passed); returns whether it was sent. Throws
   // RigError on transport or rig failure; stats() then says how far it got.
   bool feed(const RigFrame& frame);
+  // The same for a header and codes held elsewhere (a decoder's output plane, read in place).
+  bool feed(const RigFrameHeader& header, std::span<const std::uint16_t> samples);
   const FeedStats& stats() const { return stats_; }
 
   // Time one frame of this size takes on the transport at its nominal rate (0 when unbounded).
-  static double seconds_per_frame(const RigTransport& transport, const RigFrame& frame);
+  static double seconds_per_frame(const RigTransport& transport, const RigFrameHeader& frame);
 
  private:
   void send_packet(std::span<const std::uint8_t> packet, std::size_t payload_bytes);

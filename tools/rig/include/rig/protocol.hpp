@@ -38,9 +38,8 @@ inline constexpr std::size_t kMaxChunkData = 0xFFFF;  // the chunk length field 
 
 enum class ChannelOrder : std::uint8_t { Rgb = 0 };
 
-// One panel drive frame as the feeder sends it: codes row-major, pixel-interleaved R, G, B.
-// Codes of up to 8 bits travel as one byte, 9..16 bits as two bytes little-endian.
-struct RigFrame {
+// What a panel drive frame is, without its codes.
+struct RigFrameHeader {
   std::int64_t index = 0;
   int eye = 0;                 // 0 = left (or mono), 1 = right
   int width = 0, height = 0;   // size of the image carried (after region / downscale)
@@ -49,10 +48,16 @@ struct RigFrame {
   int view_width = 0, view_height = 0;  // 0: same as width / height
   int region_x = 0, region_y = 0;
   int step = 1;                // every step-th pixel of the region in both directions
-  std::vector<std::uint16_t> samples;   // width * height * 3 codes
 
   int bytes_per_sample() const { return bits <= 8 ? 1 : 2; }
   std::size_t payload_size() const;
+};
+
+// One panel drive frame as the feeder sends it: codes row-major, pixel-interleaved R, G, B.
+// Codes of up to 8 bits travel as one byte, 9..16 bits as two bytes little-endian.
+struct RigFrame : RigFrameHeader {
+  std::vector<std::uint16_t> samples;   // width * height * 3 codes
+
   void validate() const;  // throws std::invalid_argument
 };
 
@@ -112,6 +117,8 @@ using trm::crc32_ieee;
 
 // Payload bytes of a frame in wire order; throws std::invalid_argument where RigFrame::validate() would.
 std::vector<std::uint8_t> pack_samples(const RigFrame& frame);
+// The same for a header and codes held elsewhere (a decoder's output plane: no copy into a RigFrame).
+std::vector<std::uint8_t> pack_samples(const RigFrameHeader& header, std::span<const std::uint16_t> samples);
 
 std::vector<std::uint8_t> encode_frame_start(const FrameStart& start);
 std::vector<std::uint8_t> encode_chunk(const ChunkHeader& header, std::span<const std::uint8_t> data);
@@ -141,6 +148,8 @@ struct EncodedFrame {
   std::size_t wire_size() const;  // sum of all packet sizes (before transport padding)
 };
 EncodedFrame encode_frame(const RigFrame& frame, std::size_t max_packet_size, bool answer_expected);
+EncodedFrame encode_frame(const RigFrameHeader& header, std::span<const std::uint16_t> samples, std::size_t max_packet_size,
+                          bool answer_expected);
 
 // Reference receiver: reassembles frames from a stream of packets the way a rig does, checking every
 // header CRC, sequence number and the payload CRC. Used by the tests and as executable documentation.
