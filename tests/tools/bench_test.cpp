@@ -84,6 +84,28 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
   EXPECT_TRUE(report["parameters"]["formats"].empty());
 }
 
+// On one thread the banded decoder is the one-thread decoder: timed once, as "fixed", whichever of the two names
+// --only asks for (asking for fixed-1t timed nothing but the yardstick before).
+TEST(Bench, OneThreadTimesTheOneThreadDecoderUnderEitherName) {
+  ScratchDir dir("trm_bench_one_thread_");
+  for (const std::string name : {"fixed", "fixed-1t"}) {
+    const std::string json_path = dir.str(name + ".json");
+    const auto result = run_trm("bench --quick --size 128x96 --panel vive --threads 1 --only " + name + " --json " + json_path);
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+    std::ifstream in(json_path);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    ASSERT_EQ(report["results"].size(), 1u);
+    std::set<std::string> names;
+    for (const nlohmann::json& d : report["results"][0]["decoders"]) {
+      names.insert(d["name"].get<std::string>());
+      if (d["name"] == "fixed") {
+        EXPECT_EQ(d["threads"], 1) << name;
+      }
+    }
+    EXPECT_EQ(names, (std::set<std::string>{"fixed", "opencv-float32"})) << name;
+  }
+}
+
 // --format sets the fixed-point decoders' formats by trm sweep's knobs and is recorded; the §6 check then judges
 // those formats: linear light uQ1.16 cannot tell the darkest drive codes apart and is rejected before any work,
 // and a set that is accepted is held to the reference like the defaults.

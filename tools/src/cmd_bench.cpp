@@ -274,8 +274,13 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   codes_only.report_planes = false;
   FixedDecoderConfig banded = codes_only;
   banded.threads = options.threads;
-  const auto wanted = [&options](const std::string& name) {
-    return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+  const auto asked_for = [&options](const std::string& name) {
+    return std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+  };
+  // On one thread the banded decoder is the one-thread decoder: it is timed once, as "fixed", and --only fixed-1t
+  // selects it too.
+  const auto wanted = [&options, &asked_for, &banded](const std::string& name) {
+    return options.only.empty() || asked_for(name) || (name == "fixed" && banded.threads <= 1 && asked_for("fixed-1t"));
   };
   const auto add = [&contenders, &size, &wanted](std::string name, const char* impl, FixedDecoderConfig c) {
     if (!wanted(name)) return;
