@@ -45,6 +45,22 @@ TEST(RigFeeder, PacesFramesAtTheRequestedRate) {
   expect_same_frames(receive_stream(transport.bytes), frames);
 }
 
+// The feeder reuses its payload and chunk buffers from frame to frame: frames that grow, shrink, change depth and
+// fail in between still arrive each exactly as given.
+TEST(RigFeeder, ReusedBuffersCarryEveryFrameExactlyAcrossSizesAndDepths) {
+  MemoryTransport transport;
+  RigFeeder feeder(transport, FeedOptions{});
+  std::vector<RigFrame> frames = {synthetic_frame(0, 0, 40, 30, 8), synthetic_frame(1, 1, 8, 4, 10),
+                                  synthetic_frame(2, 0, 64, 48, 10), synthetic_frame(3, 0, 3, 5, 8)};
+  for (const RigFrame& f : frames) EXPECT_TRUE(feeder.feed(f));
+  RigFrame too_high = synthetic_frame(4, 0, 16, 16, 8);
+  too_high.samples.back() = 256;
+  EXPECT_THROW(feeder.feed(too_high), std::invalid_argument);
+  frames.push_back(synthetic_frame(5, 0, 16, 16, 8));
+  EXPECT_TRUE(feeder.feed(frames.back()));
+  expect_same_frames(receive_stream(transport.bytes), frames);
+}
+
 TEST(RigFeeder, DropsFramesWhoseSlotHasPassed) {
   MemoryTransport transport(25ms);  // each frame takes 2.5 slots at 100 Hz
   FeedOptions options;

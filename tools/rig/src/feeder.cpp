@@ -79,8 +79,8 @@ void RigFeeder::send_packet(std::span<const std::uint8_t> packet, std::size_t pa
 
 void RigFeeder::send_chunks(const EncodedFrame& frame, std::uint32_t first_sequence) {
   for (std::uint32_t sequence = first_sequence; sequence < frame.chunk_count(); ++sequence) {
-    const std::vector<std::uint8_t> chunk = frame.chunk_packet(sequence);
-    send_packet(chunk, chunk.size() - kChunkHeaderSize);
+    frame.chunk_packet(sequence, chunk_);
+    send_packet(chunk_, chunk_.size() - kChunkHeaderSize);
     stats_.interrupted_chunks_sent = sequence + 1;
   }
   send_packet(frame.end_packet, 0);
@@ -153,7 +153,8 @@ bool RigFeeder::feed(const RigFrameHeader& frame, std::span<const std::uint16_t>
     if (now < opens) std::this_thread::sleep_until(opens);
   }
 
-  const EncodedFrame encoded = encode_frame(frame, samples, transport_.max_packet_size(), options_.flow_control);
+  encode_frame(frame, samples, transport_.max_packet_size(), options_.flow_control, encoded_);
+  const EncodedFrame& encoded = encoded_;
   stats_.interrupted_frame = frame.index;
   stats_.interrupted_chunks_sent = 0;
   stats_.interrupted_chunk_count = encoded.chunk_count();

@@ -138,8 +138,14 @@ const char* describe_rig_error_code(std::uint8_t code) {
 std::vector<std::uint8_t> pack_samples(const RigFrame& frame) { return pack_samples(frame, frame.samples); }
 
 std::vector<std::uint8_t> pack_samples(const RigFrameHeader& header, std::span<const std::uint16_t> samples) {
+  std::vector<std::uint8_t> out;
+  pack_samples(header, samples, out);
+  return out;
+}
+
+void pack_samples(const RigFrameHeader& header, std::span<const std::uint16_t> samples, std::vector<std::uint8_t>& out) {
   check_layout(header, samples.size());
-  std::vector<std::uint8_t> out(header.payload_size());
+  out.resize(header.payload_size());
   // Through local restrict pointers: a uint8_t store may alias anything, which otherwise keeps these loops scalar.
   // The codes are checked against the bit depth in the same pass (validate()'s check without a pass of its own).
   const std::uint16_t* __restrict in = samples.data();
@@ -159,7 +165,6 @@ std::vector<std::uint8_t> pack_samples(const RigFrameHeader& header, std::span<c
     }
   }
   check_codes(any_bits, header.bits);
-  return out;
 }
 
 std::vector<std::uint8_t> encode_frame_start(const FrameStart& s) {
@@ -189,14 +194,23 @@ std::vector<std::uint8_t> encode_frame_start(const FrameStart& s) {
   return p;
 }
 
-std::vector<std::uint8_t> encode_chunk(const ChunkHeader& h, std::span<const std::uint8_t> data) {
+namespace {
+
+void encode_chunk_into(const ChunkHeader& h, std::span<const std::uint8_t> data, std::vector<std::uint8_t>& p) {
   if (data.size() != h.length) throw std::invalid_argument("chunk length does not match its data");
-  std::vector<std::uint8_t> p(kChunkHeaderSize + data.size());
+  p.resize(kChunkHeaderSize + data.size());
   p[0] = static_cast<std::uint8_t>(PacketType::Chunk);
   p[1] = h.last ? kChunkFlagLast : 0;
   put_u16(&p[2], h.length);
   put_u32(&p[4], h.sequence);
   if (!data.empty()) std::memcpy(&p[kChunkHeaderSize], data.data(), data.size());
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_chunk(const ChunkHeader& h, std::span<const std::uint8_t> data) {
+  std::vector<std::uint8_t> p;
+  encode_chunk_into(h, data, p);
   return p;
 }
 
@@ -294,13 +308,19 @@ std::vector<std::vector<std::uint8_t>> split_stream(std::span<const std::uint8_t
 }
 
 std::vector<std::uint8_t> EncodedFrame::chunk_packet(std::uint32_t sequence) const {
+  std::vector<std::uint8_t> out;
+  chunk_packet(sequence, out);
+  return out;
+}
+
+void EncodedFrame::chunk_packet(std::uint32_t sequence, std::vector<std::uint8_t>& out) const {
   const std::size_t begin = static_cast<std::size_t>(sequence) * chunk_data_size;
   const std::size_t end = std::min(payload.size(), begin + chunk_data_size);
   ChunkHeader h;
   h.sequence = sequence;
   h.last = sequence + 1 == start.chunk_count;
   h.length = static_cast<std::uint16_t>(end - begin);
-  return encode_chunk(h, std::span(payload).subspan(begin, end - begin));
+  encode_chunk_into(h, std::span(payload).subspan(begin, end - begin), out);
 }
 
 std::size_t EncodedFrame::wire_size() const {
@@ -313,13 +333,20 @@ EncodedFrame encode_frame(const RigFrame& frame, std::size_t max_packet_size, bo
 
 EncodedFrame encode_frame(const RigFrameHeader& frame, std::span<const std::uint16_t> samples, std::size_t max_packet_size,
                           bool answer_expected) {
+  EncodedFrame e;
+  encode_frame(frame, samples, max_packet_size, answer_expected, e);
+  return e;
+}
+
+void encode_frame(const RigFrameHeader& frame, std::span<const std::uint16_t> samples, std::size_t max_packet_size,
+                  bool answer_expected, EncodedFrame& e) {
   check_layout(frame, samples.size());  // the codes are checked as they are packed
   if (max_packet_size < kMinPacketSize)
     throw std::invalid_argument("transport packets of " + std::to_string(max_packet_size) +
                                 " bytes cannot carry a 64-byte FRAME_START");
-  EncodedFrame e;
   e.chunk_data_size = std::min(max_packet_size - kChunkHeaderSize, kMaxChunkData);
-  e.payload = pack_samples(frame, samples);
+  e.start = FrameStart{};
+  pack_samples(frame, samples, e.payload);
   FrameStart& s = e.start;
   s.bits = static_cast<std::uint8_t>(frame.bits);
   s.bytes_per_sample = static_cast<std::uint8_t>(frame.bytes_per_sample());
@@ -339,7 +366,6 @@ EncodedFrame encode_frame(const RigFrameHeader& frame, std::span<const std::uint
   s.payload_crc = crc32_ieee(e.payload);
   e.start_packet = encode_frame_start(s);
   e.end_packet = encode_frame_end(FrameEnd{s.chunk_count, s.frame_index, s.payload_crc});
-  return e;
 }
 
 void StreamReceiver::accept_packet(std::span<const std::uint8_t> packet) {

@@ -70,6 +70,9 @@ class RigFeeder {
   FeedStats stats_;
   std::chrono::steady_clock::time_point started_;
   std::chrono::steady_clock::time_point last_progress_;
+  // Buffers reused from frame to frame: the payload of the frame being sent and the chunk packet being sent.
+  EncodedFrame encoded_;
+  std::vector<std::uint8_t> chunk_;
   std::chrono::steady_clock::time_point paced_from_;  // when the first frame after the pre-roll was offered
   bool started_clock_ = false;
 };

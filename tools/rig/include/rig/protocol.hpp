@@ -119,6 +119,8 @@ using trm::crc32_ieee;
 std::vector<std::uint8_t> pack_samples(const RigFrame& frame);
 // The same for a header and codes held elsewhere (a decoder's output plane: no copy into a RigFrame).
 std::vector<std::uint8_t> pack_samples(const RigFrameHeader& header, std::span<const std::uint16_t> samples);
+// The same into `out`, resized to the payload (a buffer of that size already is neither reallocated nor cleared).
+void pack_samples(const RigFrameHeader& header, std::span<const std::uint16_t> samples, std::vector<std::uint8_t>& out);
 
 std::vector<std::uint8_t> encode_frame_start(const FrameStart& start);
 std::vector<std::uint8_t> encode_chunk(const ChunkHeader& header, std::span<const std::uint8_t> data);
@@ -145,11 +147,16 @@ struct EncodedFrame {
   std::size_t chunk_data_size = 0;
   std::uint32_t chunk_count() const { return start.chunk_count; }
   std::vector<std::uint8_t> chunk_packet(std::uint32_t sequence) const;
+  void chunk_packet(std::uint32_t sequence, std::vector<std::uint8_t>& out) const;  // into a reused buffer
   std::size_t wire_size() const;  // sum of all packet sizes (before transport padding)
 };
 EncodedFrame encode_frame(const RigFrame& frame, std::size_t max_packet_size, bool answer_expected);
 EncodedFrame encode_frame(const RigFrameHeader& header, std::span<const std::uint16_t> samples, std::size_t max_packet_size,
                           bool answer_expected);
+// The same into `out`, reusing its payload buffer: a feeder encoding frames of one size allocates and clears nothing
+// per frame once the first is encoded.
+void encode_frame(const RigFrameHeader& header, std::span<const std::uint16_t> samples, std::size_t max_packet_size,
+                  bool answer_expected, EncodedFrame& out);
 
 // Reference receiver: reassembles frames from a stream of packets the way a rig does, checking every
 // header CRC, sequence number and the payload CRC. Used by the tests and as executable documentation.
