@@ -57,7 +57,7 @@ struct FeedSettings {
   // pacing and flow control
   double fps = -1.0;  // < 0: the panel refresh
   bool no_drop = false;
-  int preroll = 2;  // views sent before the pace starts: the decoder's first pair touches its memory for the first time
+  int preroll = 8;  // views sent before the pace starts: the decoder's first views touch its memory for the first time
   bool flow_control = false;
   int answer_timeout_ms = 2000;
   int max_resends = 3;
@@ -400,8 +400,8 @@ void register_feed(CLI::App& app, Action& action) {
       ->check(finite_non_negative(" (0: as fast as possible; leave --fps out for the panel refresh)"));
   cmd->add_flag("--no-drop", s.no_drop, "Paced: send late views anyway instead of dropping them");
   cmd->add_option("--preroll", s.preroll,
-                  "Paced: views sent as soon as they are decoded before the pace starts (the decoder's first pair "
-                  "touches its frame stores for the first time)")
+                  "Paced: views sent as soon as they are decoded before the pace starts (the decoder's first views "
+                  "touch its frame stores for the first time)")
       ->capture_default_str()->check(CLI::Range(0, 1000000));
   cmd->add_flag("--flow-control", s.flow_control, "Wait for the rig's READY / RESEND / ERROR after every view");
   cmd->add_option("--answer-timeout", s.answer_timeout_ms, "Flow control: ms to wait for an answer")->capture_default_str()->check(CLI::Range(1, 600000));
