@@ -320,23 +320,21 @@ int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
     const bool whole_views = !roi && s.downscale == 1;
     const auto send_view = [&](const DecodedFrame& decoded) {
       const cv::Mat& codes = decoded.drive_codes;
-      if (whole_views && codes.isContinuous()) {  // packed straight from the decoder's output plane
-        const rig::RigFrameHeader header = rig_header(decoded, pipeline.output_bits);
-        if (!warned) {
-          warn_about_throughput(*transport, header, options.fps, false);
-          warned = true;
-        }
-        feeder.feed(header, std::span(codes.ptr<std::uint16_t>(), codes.total() * 3u));
-        return;
+      const bool in_place = whole_views && codes.isContinuous();  // packed straight from the decoder's output plane
+      rig::RigFrame copied;
+      if (!in_place) {
+        copied = to_rig_frame(decoded, pipeline.output_bits);
+        if (!whole_views)
+          copied = rig::crop_and_decimate(copied, roi.value_or(rig::Region{0, 0, copied.width, copied.height}), s.downscale);
       }
-      rig::RigFrame frame = to_rig_frame(decoded, pipeline.output_bits);
-      if (roi || s.downscale > 1)
-        frame = rig::crop_and_decimate(frame, roi.value_or(rig::Region{0, 0, frame.width, frame.height}), s.downscale);
+      const rig::RigFrameHeader header = in_place ? rig_header(decoded, pipeline.output_bits) : copied;
+      const std::span<const std::uint16_t> samples =
+          in_place ? std::span<const std::uint16_t>(codes.ptr<std::uint16_t>(), codes.total() * 3u) : copied.samples;
       if (!warned) {
-        warn_about_throughput(*transport, frame, options.fps, roi.has_value() || s.downscale > 1);
+        warn_about_throughput(*transport, header, options.fps, !whole_views);
         warned = true;
       }
-      feeder.feed(frame);
+      feeder.feed(header, samples);
     };
     SendingThread sender(send_view);
     if (!s.capture.empty()) {
