@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -65,7 +66,8 @@ class UpsampledLinear {
   void row(int y, double* out) const {
     upsample_row(horizontal_, y, full_.height, out);
     if (!encoded_space_) return;
-    for (int k = 0; k < 3 * full_.width; ++k) out[k] = to_linear(out[k], transfer_);
+    const auto samples = static_cast<std::size_t>(3 * full_.width);
+    to_linear(std::span<const double>(out, samples), std::span<double>(out, samples), transfer_);
   }
 
  private:
@@ -257,14 +259,29 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     double* v_row = drive.ptr<double>(y);
     std::uint16_t* q_row = codes.ptr<std::uint16_t>(y);
     double* e_row = emitted.ptr<double>(y);
-    const double* xp_row = history ? previous_wanted.ptr<double>(y) : nullptr;
-    double* vp_row = history ? previous_drive.ptr<double>(y) : nullptr;
+    if (!history) {
+      // OLED: v = x^(1/gamma_c), the row's pows a vector at a time (the same doubles as panel.drive per sample).
+      panel.oled.drive(std::span<const double>(x_row, static_cast<std::size_t>(row_len)),
+                       std::span<double>(v_row, static_cast<std::size_t>(row_len)));
+      for (int k = 0; k < row_len; ++k) {
+        if (std::isnan(v_row[k])) {
+          tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
+          q_row[k] = 0;
+        } else {
+          q_row[k] = quantise(v_row[k], top);
+        }
+        e_row[k] = emission_(q_row[k], 0, k % 3);
+      }
+      return;
+    }
+    const double* xp_row = previous_wanted.ptr<double>(y);
+    double* vp_row = previous_drive.ptr<double>(y);
     for (int k = 0; k < row_len; ++k) {
       const int ch = k % 3;
       const double x_t = x_row[k];
       if (first_lcd_frame) vp_row[k] = dequantise(quantise(panel.drive_from_linear(x_t, ch), top), top);
-      const double v_prev = history ? vp_row[k] : 0.0;
-      const PanelDriveSample sample = panel.drive(x_t, history ? xp_row[k] : 0.0, v_prev, ch);
+      const double v_prev = vp_row[k];
+      const PanelDriveSample sample = panel.drive(x_t, xp_row[k], v_prev, ch);
       v_row[k] = sample.v;
       if (std::isnan(sample.v)) {
         tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
@@ -272,9 +289,8 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
       } else {
         q_row[k] = quantise(sample.v, top);
       }
-      const auto previous_code = history ? static_cast<std::uint16_t>(std::lround(v_prev * top)) : std::uint16_t{0};
+      const auto previous_code = static_cast<std::uint16_t>(std::lround(v_prev * top));
       e_row[k] = emission_(q_row[k], previous_code, ch);
-      if (!history) continue;
       next_drive.ptr<double>(y)[k] = dequantise(q_row[k], top);
       if (record) lcd_target.ptr<double>(y)[k] = sample.target;
       if (!contributed.empty()) contributed.ptr<double>(y)[k] = sample.reachable ? x_t : sample.contributed;

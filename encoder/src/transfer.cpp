@@ -1,9 +1,12 @@
 // Transfer functions, link quantisation and luma (DESIGN §3).
 #include "trm/transfer.hpp"
 
+#include "trm/vector_pow.hpp"
+
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -28,20 +31,33 @@ void require_double(const cv::Mat& m, const char* what) {
   }
 }
 
-// Applies f to every element of a CV_64F matrix of any channel count, returning a new matrix.
-template <typename F>
-cv::Mat map_elements(const cv::Mat& in, F f) {
+// Applies a row function (span in, span out) to every row of a CV_64F matrix of any channel count, returning a new
+// matrix.
+template <typename RowFunction>
+cv::Mat map_rows(const cv::Mat& in, RowFunction row_function) {
   cv::Mat out(in.size(), in.type());
-  const int row_len = in.cols * in.channels();
+  const auto row_len = static_cast<std::size_t>(in.cols) * static_cast<std::size_t>(in.channels());
   // Rows on OpenCV's threads: every element is computed alone, so the doubles do not depend on the split.
   cv::parallel_for_(cv::Range(0, in.rows), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y) {
-      const double* src = in.ptr<double>(y);
-      double* dst = out.ptr<double>(y);
-      for (int i = 0; i < row_len; ++i) dst[i] = f(src[i]);
+      row_function(std::span<const double>(in.ptr<double>(y), row_len), std::span<double>(out.ptr<double>(y), row_len));
     }
   });
   return out;
+}
+
+// Runs `each` over [0, n) in chunks of at most kPowChunk elements, with a scratch array for the chunk's pows.
+constexpr std::size_t kPowChunk = 256;
+template <typename Chunk>
+void in_pow_chunks(std::size_t n, Chunk each) {
+  std::array<double, kPowChunk> scratch;
+  for (std::size_t start = 0; start < n; start += kPowChunk) {
+    each(start, std::min(kPowChunk, n - start), std::span<double>(scratch));
+  }
+}
+
+void require_same_size(std::size_t in, std::size_t out, const char* what) {
+  if (in != out) throw std::invalid_argument(std::string(what) + ": input and output differ in size");
 }
 
 void require_bits(int bits) {
@@ -67,14 +83,59 @@ double to_encoded(double linear, Transfer transfer) {
   return (1.0 + kSrgbOffset) * std::pow(l, 1.0 / kSrgbExponent) - kSrgbOffset;
 }
 
+// The scalar functions' expressions with their pows taken a chunk at a time; elements on the linear segment or at
+// peak white discard the pow computed for them.
+void to_linear(std::span<const double> encoded, std::span<double> linear, Transfer transfer) {
+  require_same_size(encoded.size(), linear.size(), "to_linear");
+  const bool gamma = transfer == Transfer::Gamma22;
+  in_pow_chunks(encoded.size(), [&](std::size_t start, std::size_t count, std::span<double> power) {
+    const double* in = encoded.data() + start;
+    for (std::size_t k = 0; k < count; ++k) {
+      const double v = clamp01(in[k]);
+      power[k] = gamma ? v : (v + kSrgbOffset) / (1.0 + kSrgbOffset);
+    }
+    pow_elements(power.first(count), gamma ? kPureGamma : kSrgbExponent, power.first(count));
+    double* out = linear.data() + start;
+    for (std::size_t k = 0; k < count; ++k) {
+      const double v = clamp01(in[k]);
+      out[k] = !gamma && v <= kSrgbEncodedBreak ? v / kSrgbSlope : power[k];
+    }
+  });
+}
+
+void to_encoded(std::span<const double> linear, std::span<double> encoded, Transfer transfer) {
+  require_same_size(linear.size(), encoded.size(), "to_encoded");
+  const bool gamma = transfer == Transfer::Gamma22;
+  in_pow_chunks(linear.size(), [&](std::size_t start, std::size_t count, std::span<double> power) {
+    const double* in = linear.data() + start;
+    for (std::size_t k = 0; k < count; ++k) power[k] = clamp01(in[k]);
+    pow_elements(power.first(count), gamma ? 1.0 / kPureGamma : 1.0 / kSrgbExponent, power.first(count));
+    double* out = encoded.data() + start;
+    for (std::size_t k = 0; k < count; ++k) {
+      const double l = clamp01(in[k]);
+      if (gamma) {
+        out[k] = power[k];
+      } else if (l <= kSrgbLinearBreak) {
+        out[k] = l * kSrgbSlope;
+      } else {
+        out[k] = l == 1.0 ? 1.0 : (1.0 + kSrgbOffset) * power[k] - kSrgbOffset;
+      }
+    }
+  });
+}
+
 cv::Mat to_linear(const cv::Mat& encoded, Transfer transfer) {
   require_double(encoded, "to_linear");
-  return map_elements(encoded, [transfer](double v) { return to_linear(v, transfer); });
+  return map_rows(encoded, [transfer](std::span<const double> in, std::span<double> out) {
+    to_linear(in, out, transfer);
+  });
 }
 
 cv::Mat to_encoded(const cv::Mat& linear, Transfer transfer) {
   require_double(linear, "to_encoded");
-  return map_elements(linear, [transfer](double v) { return to_encoded(v, transfer); });
+  return map_rows(linear, [transfer](std::span<const double> in, std::span<double> out) {
+    to_encoded(in, out, transfer);
+  });
 }
 
 cv::Mat quantise(const cv::Mat& values, int bits) {

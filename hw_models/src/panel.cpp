@@ -1,6 +1,8 @@
 // Panel models (DESIGN §4 "Panel drive", paper Sec. 4.4) in double precision.
 #include "trm/panel.hpp"
 
+#include "trm/vector_pow.hpp"
+
 #include "perception_checks.hpp"
 
 #include <nlohmann/json.hpp>
@@ -199,6 +201,21 @@ double OledPanel::emitted(double v, int channel) const {
 
 double OledPanel::drive(double x, int channel) const {
   return std::pow(std::clamp(x, 0.0, 1.0), 1.0 / gamma.at(static_cast<std::size_t>(channel)));
+}
+
+void OledPanel::drive(std::span<const double> x, std::span<double> v) const {
+  if (x.size() != v.size()) throw std::invalid_argument("OledPanel::drive: x and v differ in size");
+  // A chunk of whole pixels, so its exponents start at red.
+  constexpr std::size_t kChunk = 255;
+  std::array<double, kChunk> exponent;
+  for (std::size_t k = 0; k < kChunk; ++k) exponent[k] = 1.0 / gamma.at(k % 3);
+  std::array<double, kChunk> base;
+  for (std::size_t start = 0; start < x.size(); start += kChunk) {
+    const std::size_t count = std::min(kChunk, x.size() - start);
+    for (std::size_t k = 0; k < count; ++k) base[k] = std::clamp(x[start + k], 0.0, 1.0);
+    pow_elements(std::span<const double>(base.data(), count), std::span<const double>(exponent.data(), count),
+                 v.subspan(start, count));
+  }
 }
 
 std::array<double, 3> Panel::channel_gammas() const {

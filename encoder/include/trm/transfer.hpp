@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 
 namespace trm {
 
@@ -14,6 +15,10 @@ double to_linear(double encoded, Transfer transfer);
 double to_encoded(double linear, Transfer transfer);
 cv::Mat to_linear(const cv::Mat& encoded, Transfer transfer);   // CV_64F, any channel count
 cv::Mat to_encoded(const cv::Mat& linear, Transfer transfer);
+// The same doubles for every element of an array (out may be in; the sizes must match), the pows a vector at a time
+// (trm/vector_pow.hpp): what the reference decoder calls on each row.
+void to_linear(std::span<const double> encoded, std::span<double> linear, Transfer transfer);
+void to_encoded(std::span<const double> linear, std::span<double> encoded, Transfer transfer);
 
 // q = floor(x * (2^bits - 1) + 0.5) after clamping x to [0, 1]; returns CV_16U with the same channels.
 cv::Mat quantise(const cv::Mat& values, int bits);

@@ -18,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,9 @@ struct OledPanel {
   double emitted(double v, int channel) const;
   // v = clamp(x, 0, 1)^(1/gamma_c).
   double drive(double x, int channel) const;
+  // The same doubles for interleaved RGB samples (channel = index % 3; v may be x, the sizes must match), the pows a
+  // vector at a time (trm/vector_pow.hpp).
+  void drive(std::span<const double> x, std::span<double> v) const;
   // Throws std::invalid_argument with `what` and the broken rule (see validate_panel).
   void validate(const std::string& what) const;
   friend bool operator==(const OledPanel&, const OledPanel&) = default;

@@ -1,0 +1,228 @@
+// pow_elements (trm/vector_pow.hpp): glibc's pow a vector at a time, compiled once per x86 instruction set by
+// Highway's foreach_target and chosen at run time. The order of operations and the fused multiply-adds follow the
+// FMA build of glibc 2.36's pow (__ieee754_pow_fma, its disassembly read operation by operation): a fusion more or
+// less than glibc's changes the last bit of about one result in three. Hence this file compiles with
+// -ffp-contract=off (fixed_point/CMakeLists.txt): only hn::MulAdd / hn::MulSub fuse.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "vector_pow.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+// Compiled once, before the per-target code.
+#ifndef TRM_VECTOR_POW_SHARED
+#define TRM_VECTOR_POW_SHARED
+namespace trm::vector_pow_detail {
+
+inline void libm_elements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) out[k] = std::pow(x[k], y[k * y_step]);
+}
+
+// What a target's kernel is checked on before its first use: x across (0, 2], half of it pseudo-random (a 64-bit
+// linear congruential generator's top 52 bits as a mantissa), half with dense samples near 0, near 1 and at the
+// exponent boundaries of the tables. It catches a C library whose pow is another algorithm (most results differ); an
+// operation fused where glibc's is not can change as few as one result in a million, which is for the tests'
+// millions of inputs (tests/fixed_point/vector_pow_test.cpp) to find.
+constexpr std::size_t kCheckCount = 16384;
+inline std::array<double, kCheckCount> check_inputs() {
+  std::array<double, kCheckCount> x{};
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL;
+  for (std::size_t k = 0; k < kCheckCount; ++k) {
+    const double t = (static_cast<double>(k) + 0.5) / kCheckCount;
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double random = std::ldexp(static_cast<double>(state >> 12), -52);  // [0, 1)
+    x[k] = k % 2 == 0   ? 2.0 * random + 0x1p-30
+           : k % 8 == 1 ? t * t * t
+           : k % 8 == 3 ? 1.0 - std::ldexp(t, -static_cast<int>(k % 40))
+           : k % 8 == 5 ? std::ldexp(1.0 + t, -static_cast<int>(k % 64))
+                        : 2.0 * t;
+  }
+  return x;
+}
+// The exponents trm uses most: sRGB 2.4 and 1/2.4, gamma 2.2 and 1/2.2.
+constexpr std::array<double, 4> kCheckExponents{2.4, 1.0 / 2.4, 2.2, 1.0 / 2.2};
+
+}  // namespace trm::vector_pow_detail
+#endif
+
+HWY_BEFORE_NAMESPACE();
+namespace trm::vector_pow_detail {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+#if HWY_TARGET <= HWY_AVX2 && HWY_NATIVE_FMA
+#include "vector_pow_tables.inc"
+
+// x^y for one vector; lanes on glibc's special paths are marked in `special` and must be recomputed by std::pow.
+template <class D>
+hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::RebindToSigned<D>>& special) {
+  const hn::RebindToSigned<D> di;
+  using VD = hn::Vec<D>;
+  using VI = hn::Vec<decltype(di)>;
+  const VI ix = hn::BitCast(di, x);
+  const VI top_y = hn::And(hn::ShiftRight<52>(hn::BitCast(di, y)), hn::Set(di, 0x7ff));
+  // glibc: top12(x) - 1 >= 0x7fe (x <= 0 or subnormal, inf, NaN, or negative), |y| outside [2^-65, 2^63) or NaN.
+  special = hn::Or(hn::Lt(ix, hn::Set(di, std::int64_t{0x0010000000000000})),
+                   hn::Gt(ix, hn::Set(di, std::int64_t{0x7fefffffffffffff})));
+  special = hn::Or(special, hn::Or(hn::Lt(top_y, hn::Set(di, 0x3be)), hn::Gt(top_y, hn::Set(di, 0x43d))));
+
+  // log_inline: x = 2^k z with z in [0x1.6955p-1, 0x1.6955p0), log x = k ln2 + log c + log1p(z / c - 1).
+  const VI tmp = hn::Sub(ix, hn::Set(di, std::int64_t{0x3fe6955500000000}));
+  const VI entry = hn::Mul(hn::And(hn::ShiftRight<45>(tmp), hn::Set(di, 127)), hn::Set(di, 3));
+  const VD kd = hn::ConvertTo(d, hn::ShiftRight<52>(tmp));  // arithmetic shift: k
+  const VD z = hn::BitCast(d, hn::Sub(ix, hn::And(tmp, hn::Set(di, static_cast<std::int64_t>(0xfffULL << 52)))));
+  const VD invc = hn::GatherIndex(d, kLogTable, entry);
+  const VD logc = hn::GatherIndex(d, kLogTable + 1, entry);
+  const VD logctail = hn::GatherIndex(d, kLogTable + 2, entry);
+  const VD r = hn::MulAdd(z, invc, hn::Set(d, -1.0));
+  const VD t1 = hn::MulAdd(kd, hn::Set(d, kLn2Hi), logc);
+  const VD t2 = hn::Add(t1, r);
+  const VD lo1 = hn::MulAdd(kd, hn::Set(d, kLn2Lo), logctail);
+  const VD lo2 = hn::Add(hn::Sub(t1, t2), r);
+  const VD ar = hn::Mul(r, hn::Set(d, kLogPoly[0]));
+  const VD ar2 = hn::Mul(r, ar);
+  const VD ar3 = hn::Mul(r, ar2);
+  const VD hi = hn::Add(t2, ar2);
+  const VD lo3 = hn::MulSub(ar, r, ar2);
+  const VD lo4 = hn::Add(hn::Sub(t2, hi), ar2);
+  const VD a12 = hn::MulAdd(r, hn::Set(d, kLogPoly[2]), hn::Set(d, kLogPoly[1]));
+  const VD a34 = hn::MulAdd(r, hn::Set(d, kLogPoly[4]), hn::Set(d, kLogPoly[3]));
+  const VD a56 = hn::MulAdd(r, hn::Set(d, kLogPoly[6]), hn::Set(d, kLogPoly[5]));
+  const VD poly = hn::MulAdd(ar2, hn::MulAdd(a56, ar2, a34), a12);
+  const VD lo = hn::MulAdd(ar3, poly, hn::Add(hn::Add(hn::Add(lo1, lo2), lo3), lo4));
+  const VD log_hi = hn::Add(hi, lo);
+  const VD log_lo = hn::Add(hn::Sub(hi, log_hi), lo);
+
+  // y log x as ehi + elo.
+  const VD ehi = hn::Mul(y, log_hi);
+  const VD elo = hn::MulAdd(y, log_lo, hn::MulSub(log_hi, y, ehi));
+  // exp_inline's own special cases: |ehi| < 2^-54 (x^y rounds to 1 +- ulp) or >= 512 (over/underflow).
+  const VI abstop = hn::And(hn::ShiftRight<52>(hn::BitCast(di, ehi)), hn::Set(di, 0x7ff));
+  special = hn::Or(special, hn::Or(hn::Lt(abstop, hn::Set(di, 0x3c9)), hn::Gt(abstop, hn::Set(di, 0x407))));
+
+  // exp_inline: exp(ehi + elo) = 2^(k/128) exp(r), r = ehi - k ln2/128 + elo.
+  const VD shifted = hn::MulAdd(ehi, hn::Set(d, kInvLn2N), hn::Set(d, kShift));
+  const VI ki = hn::BitCast(di, shifted);
+  const VD ke = hn::Sub(shifted, hn::Set(d, kShift));
+  const VD r_hi = hn::MulAdd(ke, hn::Set(d, kNegLn2LoN), hn::MulAdd(ke, hn::Set(d, kNegLn2HiN), ehi));
+  const VD re = hn::Add(elo, r_hi);
+  const VI slot = hn::ShiftLeft<1>(hn::And(ki, hn::Set(di, 127)));
+  const auto* exp_words = reinterpret_cast<const std::int64_t*>(kExpTable);
+  const VD tail = hn::BitCast(d, hn::GatherIndex(di, exp_words, slot));
+  const VD scale = hn::BitCast(d, hn::Add(hn::GatherIndex(di, exp_words + 1, slot), hn::ShiftLeft<45>(ki)));
+  const VD c23 = hn::MulAdd(re, hn::Set(d, kExpPoly[1]), hn::Set(d, kExpPoly[0]));
+  const VD tail_r = hn::Add(re, tail);
+  const VD r2 = hn::Mul(re, re);
+  const VD c45 = hn::MulAdd(re, hn::Set(d, kExpPoly[3]), hn::Set(d, kExpPoly[2]));
+  const VD sum = hn::MulAdd(c45, hn::Mul(r2, r2), hn::MulAdd(c23, r2, tail_r));
+  return hn::MulAdd(sum, scale, scale);
+}
+
+// y_step 0: y[0] for every element; 1: y[k].
+void KernelElements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
+  const hn::ScalableTag<double> d;
+  const hn::RebindToSigned<decltype(d)> di;
+  const std::size_t lanes = hn::Lanes(d);
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes) {
+    const auto vx = hn::LoadU(d, x + k);
+    const auto vy = y_step == 0 ? hn::Set(d, y[0]) : hn::LoadU(d, y + k);
+    hn::Mask<decltype(di)> special;
+    auto result = PowVector(d, vx, vy, special);
+    if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
+      // From the vectors, not from x: out may be x.
+      HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
+      HWY_ALIGN double xs[hn::MaxLanes(d)];
+      HWY_ALIGN double ys[hn::MaxLanes(d)];
+      HWY_ALIGN double rs[hn::MaxLanes(d)];
+      hn::Store(hn::VecFromMask(di, special), di, marked);
+      hn::Store(vx, d, xs);
+      hn::Store(vy, d, ys);
+      hn::Store(result, d, rs);
+      for (std::size_t j = 0; j < lanes; ++j) {
+        if (marked[j] != 0) rs[j] = std::pow(xs[j], ys[j]);
+      }
+      result = hn::Load(d, rs);
+    }
+    hn::StoreU(result, d, out + k);
+  }
+  libm_elements(x + k, y + k * y_step, y_step, out + k, n - k);
+}
+
+// Each target checks its own kernel against std::pow at its first use (the C library might not be glibc 2.36's).
+bool UseKernel() {
+  static const bool agrees = [] {
+    const std::array<double, kCheckCount> x = check_inputs();
+    std::array<double, kCheckCount> fast{};
+    std::array<double, kCheckCount> exact{};
+    for (const double y : kCheckExponents) {
+      KernelElements(x.data(), &y, 0, fast.data(), kCheckCount);
+      libm_elements(x.data(), &y, 0, exact.data(), kCheckCount);
+      if (std::memcmp(fast.data(), exact.data(), sizeof fast) != 0) return false;
+    }
+    return true;
+  }();
+  return agrees;
+}
+
+void PowElements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
+  if (UseKernel()) {
+    KernelElements(x, y, y_step, out, n);
+  } else {
+    libm_elements(x, y, y_step, out, n);
+  }
+}
+
+const char* Path() { return UseKernel() ? hwy::TargetName(HWY_TARGET) : "libm"; }
+#else
+// No FMA (glibc's pow takes its other build there), or not x86: libm itself.
+void PowElements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
+  libm_elements(x, y, y_step, out, n);
+}
+const char* Path() { return "libm"; }
+#endif
+
+}  // namespace HWY_NAMESPACE
+}  // namespace trm::vector_pow_detail
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+#include "trm/vector_pow.hpp"
+
+#include <stdexcept>
+
+namespace trm {
+namespace vector_pow_detail {
+
+HWY_EXPORT(PowElements);
+HWY_EXPORT(Path);
+
+void elements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(PowElements)(x, y, y_step, out, n);
+}
+const char* path() { return HWY_DYNAMIC_DISPATCH(Path)(); }
+
+}  // namespace vector_pow_detail
+
+void pow_elements(std::span<const double> x, double y, std::span<double> out) {
+  if (x.size() != out.size()) throw std::invalid_argument("pow_elements: x and out differ in size");
+  vector_pow_detail::elements(x.data(), &y, 0, out.data(), x.size());
+}
+
+void pow_elements(std::span<const double> x, std::span<const double> y, std::span<double> out) {
+  if (x.size() != out.size() || y.size() != x.size()) {
+    throw std::invalid_argument("pow_elements: x, y and out differ in size");
+  }
+  vector_pow_detail::elements(x.data(), y.data(), 1, out.data(), x.size());
+}
+
+const char* pow_elements_path() { return vector_pow_detail::path(); }
+
+}  // namespace trm
+#endif

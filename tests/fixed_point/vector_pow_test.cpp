@@ -1,0 +1,129 @@
+// pow_elements against std::pow, bit for bit, on every instruction set this CPU runs.
+#include "trm/vector_pow.hpp"
+
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+// Restricts Highway's dispatch to one target for the test's lifetime.
+struct TargetMock {
+  explicit TargetMock(std::int64_t target) { hwy::SetSupportedTargetsForTest(target); }
+  ~TargetMock() { hwy::SetSupportedTargetsForTest(0); }
+  TargetMock(const TargetMock&) = delete;
+  TargetMock& operator=(const TargetMock&) = delete;
+};
+
+// Highway's targets this CPU runs and this build compiled, best first.
+std::vector<std::int64_t> supported_targets() { return hwy::SupportedAndGeneratedTargets(); }
+
+std::uint64_t bits_of(double v) {
+  std::uint64_t out = 0;
+  std::memcpy(&out, &v, sizeof out);
+  return out;
+}
+
+// The first index where `got` differs from std::pow in any bit, or -1.
+long first_difference(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& got) {
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (bits_of(got[k]) != bits_of(std::pow(x[k], y[k]))) return static_cast<long>(k);
+  }
+  return -1;
+}
+
+// Inputs of the kinds the decoder and the transfer functions see, and the ones that are hardest for the algorithm:
+// uniform in [0, 1] (codes, linear light), 2^-60..1 (dark samples), 1 - 2^-50..1 (near white: log x near 0),
+// (0, 4], 0 and 1 scattered among them, and per-element exponents.
+std::vector<double> sample_inputs(std::mt19937_64& rng, int kind, std::size_t n) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> x(n);
+  for (double& v : x) {
+    switch (kind) {
+      case 0: v = unit(rng); break;
+      case 1: v = std::ldexp(unit(rng), -static_cast<int>(rng() % 60)); break;
+      case 2: v = 1.0 - std::ldexp(unit(rng), -static_cast<int>(rng() % 50)); break;
+      default: v = 4.0 * unit(rng); break;
+    }
+    if (rng() % 61 == 0) v = rng() % 2 == 0 ? 0.0 : 1.0;
+  }
+  return x;
+}
+
+TEST(VectorPow, EveryElementIsStdPowOnEveryTarget) {
+  const double exponents[] = {2.4, 1.0 / 2.4, 2.2, 1.0 / 2.2, 1.8, 2.6, 0.5, 3.0, -1.5};
+  for (const std::int64_t target : supported_targets()) {
+    TargetMock mock(target);
+    SCOPED_TRACE(std::string("target ") + hwy::TargetName(target) + ", kernel path " + trm::pow_elements_path());
+    std::mt19937_64 rng(static_cast<std::uint64_t>(target));
+    for (int kind = 0; kind < 4; ++kind) {
+      // 1021: not a multiple of any vector length, so the scalar tail runs too.
+      const std::vector<double> x = sample_inputs(rng, kind, 1021 * 256);
+      for (const double exponent : exponents) {
+        const std::vector<double> y(x.size(), exponent);
+        std::vector<double> got(x.size());
+        trm::pow_elements(x, exponent, got);
+        EXPECT_EQ(first_difference(x, y, got), -1) << "x kind " << kind << ", y = " << exponent;
+      }
+      std::vector<double> y(x.size());
+      for (std::size_t k = 0; k < y.size(); ++k) y[k] = exponents[(k * 7 + rng() % 3) % std::size(exponents)];
+      std::vector<double> got(x.size());
+      trm::pow_elements(x, y, got);
+      EXPECT_EQ(first_difference(x, y, got), -1) << "x kind " << kind << ", exponents per element";
+    }
+  }
+}
+
+TEST(VectorPow, SpecialOperandsTakeLibmsPaths) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double specials[] = {0.0,   -0.0, 1.0,  -1.0, 2.0,   -2.0, inf, -inf, nan, 4.9e-324, 2.2e-308, 1e-300,
+                              1e300, 0.5,  1e-5, 1.0 - 1e-16, 1.0 + 2.2e-16, 1.7976931348623157e308};
+  const double exponents[] = {2.4, -2.4, 0.0, -0.0, 1.0, 2.0, 3.0, 0.5, inf, -inf, nan, 1e-20, 1e20, 1e-300, 700.0};
+  std::vector<double> x;
+  std::vector<double> y;
+  for (const double a : specials) {
+    for (const double b : exponents) {
+      x.push_back(a);
+      y.push_back(b);
+    }
+  }
+  for (const std::int64_t target : supported_targets()) {
+    TargetMock mock(target);
+    SCOPED_TRACE(std::string("target ") + hwy::TargetName(target));
+    std::vector<double> got(x.size());
+    trm::pow_elements(x, y, got);
+    const long k = first_difference(x, y, got);
+    EXPECT_EQ(k, -1) << "pow(" << (k >= 0 ? x[static_cast<std::size_t>(k)] : 0.0) << ", "
+                     << (k >= 0 ? y[static_cast<std::size_t>(k)] : 0.0) << ")";
+  }
+}
+
+TEST(VectorPow, InPlaceAndSizeChecks) {
+  std::vector<double> values{0.25, 0.5, 0.75, 1.0, 0.0, 0.125, 0.9, 0.3, 0.6, 0.01};
+  const std::vector<double> original = values;
+  trm::pow_elements(values, 2.4, values);
+  for (std::size_t k = 0; k < values.size(); ++k) EXPECT_EQ(bits_of(values[k]), bits_of(std::pow(original[k], 2.4)));
+  std::vector<double> shorter(values.size() - 1);
+  EXPECT_THROW(trm::pow_elements(values, 2.4, shorter), std::invalid_argument);
+  const std::vector<double> exponents(values.size() + 1, 2.4);
+  std::vector<double> out(values.size());
+  EXPECT_THROW(trm::pow_elements(values, exponents, out), std::invalid_argument);
+}
+
+// On a CPU with FMA and AVX2 (the CI machines) the kernel must be the one in use: its first-use check against
+// std::pow passed. Elsewhere std::pow computes every element, which the tests above cover as well.
+TEST(VectorPow, KernelIsInUseWhereTheCpuHasFma) {
+  const std::int64_t best = supported_targets().front();
+  if (best > HWY_AVX2) GTEST_SKIP() << "this CPU's best target is " << hwy::TargetName(best) << " (no FMA)";
+  EXPECT_STRNE(trm::pow_elements_path(), "libm");
+}
+
+}  // namespace
