@@ -17,6 +17,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -276,12 +277,24 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     }
     const double* xp_row = previous_wanted.ptr<double>(y);
     double* vp_row = previous_drive.ptr<double>(y);
+    if (first_lcd_frame) {
+      for (int k = 0; k < row_len; ++k) {
+        vp_row[k] = dequantise(quantise(panel.drive_from_linear(x_row[k], k % 3), top), top);
+      }
+    }
+    // The LCD drive of the row a chunk at a time (the same doubles as panel.drive per sample).
+    constexpr int kChunk = 255;
+    std::array<PanelDriveSample, kChunk> samples;
     for (int k = 0; k < row_len; ++k) {
       const int ch = k % 3;
       const double x_t = x_row[k];
-      if (first_lcd_frame) vp_row[k] = dequantise(quantise(panel.drive_from_linear(x_t, ch), top), top);
       const double v_prev = vp_row[k];
-      const PanelDriveSample sample = panel.drive(x_t, xp_row[k], v_prev, ch);
+      if (k % kChunk == 0) {
+        const auto count = static_cast<std::size_t>(std::min(kChunk, row_len - k));
+        panel.lcd.drive(std::span<const double>(x_row + k, count), std::span<const double>(xp_row + k, count),
+                        std::span<const double>(vp_row + k, count), std::span<PanelDriveSample>(samples.data(), count));
+      }
+      const PanelDriveSample& sample = samples[static_cast<std::size_t>(k % kChunk)];
       v_row[k] = sample.v;
       if (std::isnan(sample.v)) {
         tallies.nan_drive[static_cast<std::size_t>(y)] = 1;

@@ -170,13 +170,36 @@ double LcdPanel::target(double x_t, double x_prev) const {
 // actually shown. Where m is unreachable v_t is clamped to the closest attainable merge, and the pair then averages
 // to M(v_t, v_{t-1})^gamma: frame t effectively contributed x_t_eff = 2 M(v_t, v_{t-1})^gamma - x_{t-1}.
 PanelDriveSample LcdPanel::drive(double x_t, double x_prev, double v_prev) const {
+  return drive_to(target(x_t, x_prev), x_t, x_prev, v_prev);
+}
+
+PanelDriveSample LcdPanel::drive_to(double m, double x_t, double x_prev, double v_prev) const {
   PanelDriveSample out;
-  out.target = target(x_t, x_prev);
-  const Solution solution = solve(out.target, v_prev);
+  out.target = m;
+  const Solution solution = solve(m, v_prev);
   out.v = solution.v;
   out.reachable = solution.reachable;
   out.contributed = solution.reachable ? x_t : 2.0 * emitted(solution.v, v_prev) - x_prev;
   return out;
+}
+
+void LcdPanel::drive(std::span<const double> x_t, std::span<const double> x_prev, std::span<const double> v_prev,
+                     std::span<PanelDriveSample> out) const {
+  if (x_prev.size() != x_t.size() || v_prev.size() != x_t.size() || out.size() != x_t.size()) {
+    throw std::invalid_argument("LcdPanel::drive: x_t, x_prev, v_prev and out differ in size");
+  }
+  constexpr std::size_t kChunk = 256;
+  std::array<double, kChunk> targets;
+  for (std::size_t start = 0; start < x_t.size(); start += kChunk) {
+    const std::size_t count = std::min(kChunk, x_t.size() - start);
+    for (std::size_t k = 0; k < count; ++k) targets[k] = std::max(0.5 * (x_t[start + k] + x_prev[start + k]), 0.0);
+    const std::span<double> target(targets.data(), count);
+    pow_elements(target, 1.0 / gamma, target);  // target()
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t i = start + k;
+      out[i] = drive_to(target[k], x_t[i], x_prev[i], v_prev[i]);
+    }
+  }
 }
 
 LcdPanel LcdPanel::held() const {

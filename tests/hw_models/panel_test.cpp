@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -119,6 +121,62 @@ TEST(OledPanel, DriveIsTheInverseGammaPerChannel) {
   // Out-of-range linear input is clamped to the displayable range.
   EXPECT_EQ(vive.drive_from_linear(1.5, 1), 1.0);
   EXPECT_EQ(vive.drive_from_linear(-0.5, 1), 0.0);
+}
+
+// The row drives (a vector pow per chunk) against the per-sample ones, bit for bit: run lengths across the chunk
+// sizes, values in and outside [0, 1], zeros, NaN, and (LCD) unreachable targets.
+std::vector<double> drive_inputs(std::size_t n, std::uint64_t seed) {
+  std::vector<double> x(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double u = std::ldexp(static_cast<double>(seed >> 11), -53);
+    x[k] = k % 97 == 5 ? std::nan("") : k % 13 == 0 ? 0.0 : k % 11 == 0 ? 1.0 : -0.2 + 1.4 * u;
+  }
+  return x;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(OledPanel, RowDriveIsThePerSampleDriveBitForBit) {
+  const Panel vive = parse_panel("vive");
+  for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{7}, std::size_t{255}, std::size_t{256},
+                              std::size_t{6480}}) {
+    const std::vector<double> x = drive_inputs(n, n + 1);
+    std::vector<double> v(n);
+    vive.oled.drive(x, v);
+    for (std::size_t k = 0; k < n; ++k) {
+      ASSERT_TRUE(same_bits(v[k], vive.oled.drive(x[k], static_cast<int>(k % 3)))) << "n " << n << " k " << k;
+    }
+  }
+  std::vector<double> shorter(3);
+  EXPECT_THROW(vive.oled.drive(std::vector<double>(4), shorter), std::invalid_argument);
+}
+
+TEST(LcdPanel, RowDriveIsThePerSampleDriveBitForBit) {
+  for (const LcdPanel& lcd : {LcdPanel{}, lcd_with(0.3, -0.2, 0.45, 0.02), lcd_with(0.0, 0.0, 0.5, 0.0)}) {
+    for (const std::size_t n : {std::size_t{1}, std::size_t{255}, std::size_t{257}, std::size_t{6480}}) {
+      const std::vector<double> x_t = drive_inputs(n, 3 * n);
+      const std::vector<double> x_prev = drive_inputs(n, 5 * n + 1);
+      std::vector<double> v_prev = drive_inputs(n, 7 * n + 2);
+      for (double& v : v_prev) v = std::isnan(v) ? 0.5 : std::clamp(v, 0.0, 1.0);
+      std::vector<PanelDriveSample> row(n);
+      lcd.drive(x_t, x_prev, v_prev, row);
+      std::size_t unreachable = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const PanelDriveSample one = lcd.drive(x_t[k], x_prev[k], v_prev[k]);
+        ASSERT_TRUE(same_bits(row[k].v, one.v) && same_bits(row[k].target, one.target) &&
+                    same_bits(row[k].contributed, one.contributed) && row[k].reachable == one.reachable)
+            << "n " << n << " k " << k;
+        unreachable += one.reachable ? 0 : 1;
+      }
+      if (n == 6480) {
+        EXPECT_GT(unreachable, 0U);
+      }
+    }
+  }
+  std::vector<PanelDriveSample> out(2);
+  const std::vector<double> two(2);
+  EXPECT_THROW(LcdPanel{}.drive(two, std::vector<double>(3), two, out), std::invalid_argument);
 }
 
 TEST(LcdPanel, MergeMatchesEquation7) {

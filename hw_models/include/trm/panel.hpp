@@ -82,6 +82,10 @@ struct LcdPanel {
   double target(double x_t, double x_prev) const;
   // The drive of x_t after a frame that contributed x_prev and was driven at v_prev (DESIGN §4 inverse).
   PanelDriveSample drive(double x_t, double x_prev, double v_prev) const;
+  // drive() of every sample of a run (all four spans of one length, else std::invalid_argument): the same doubles,
+  // the pair targets' pows a vector at a time.
+  void drive(std::span<const double> x_t, std::span<const double> x_prev, std::span<const double> v_prev,
+             std::span<PanelDriveSample> out) const;
   // The merge of a pixel held at one drive, M(v, v), as a merge in v_t alone: p1' = 2 p1 + p2, p2' = 0,
   // p3' = 2 p3, p4' = p4 at v_prev = 0 (so the stable solver applies to it).
   LcdPanel held() const;
@@ -90,6 +94,10 @@ struct LcdPanel {
   // Throws std::invalid_argument with `what` and the broken rule (see validate_panel).
   void validate(const std::string& what) const;
   friend bool operator==(const LcdPanel&, const LcdPanel&) = default;
+
+ private:
+  // drive() with the pair target m already computed.
+  PanelDriveSample drive_to(double m, double x_t, double x_prev, double v_prev) const;
 };
 
 enum class PanelKind { Oled, Lcd };
