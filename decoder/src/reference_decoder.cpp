@@ -264,15 +264,15 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
       // OLED: v = x^(1/gamma_c), the row's pows a vector at a time (the same doubles as panel.drive per sample).
       panel.oled.drive(std::span<const double>(x_row, static_cast<std::size_t>(row_len)),
                        std::span<double>(v_row, static_cast<std::size_t>(row_len)));
+      bool nan = false;
       for (int k = 0; k < row_len; ++k) {
-        if (std::isnan(v_row[k])) {
-          tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
-          q_row[k] = 0;
-        } else {
-          q_row[k] = quantise(v_row[k], top);
-        }
-        e_row[k] = emission_(q_row[k], 0, k % 3);
+        const double v = v_row[k];
+        nan |= std::isnan(v);
+        q_row[k] = std::isnan(v) ? std::uint16_t{0} : quantise(v, top);
       }
+      if (nan) tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
+      emission_.row(std::span<const std::uint16_t>(q_row, static_cast<std::size_t>(row_len)),
+                    std::span<double>(e_row, static_cast<std::size_t>(row_len)));
       return;
     }
     const double* xp_row = previous_wanted.ptr<double>(y);

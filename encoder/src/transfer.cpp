@@ -10,6 +10,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace trm {
 namespace {
@@ -180,20 +181,24 @@ cv::Mat quantise_reduced(const cv::Mat& values, int bits) {
 cv::Mat dequantise(const cv::Mat& codes, int bits) {
   if (codes.depth() != CV_16U) throw std::invalid_argument("dequantise: expected a CV_16U matrix");
   require_bits(bits);
-  const double max_code = static_cast<double>((1 << bits) - 1);
+  const int max_code = (1 << bits) - 1;
+  // Every code's value once (the same division), then a lookup per sample.
+  std::vector<double> value_of(static_cast<std::size_t>(max_code) + 1);
+  for (int code = 0; code <= max_code; ++code) {
+    value_of[static_cast<std::size_t>(code)] = dequantise(static_cast<std::uint16_t>(code), max_code);
+  }
   cv::Mat values(codes.size(), CV_MAKETYPE(CV_64F, codes.channels()));
   const int row_len = codes.cols * codes.channels();
   for (int y = 0; y < codes.rows; ++y) {
     const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
     double* dst = values.ptr<double>(y);
-    for (int i = 0; i < row_len; ++i) {
-      // Codes above the maximum cannot come from quantise(); they indicate a bit-depth mix-up.
-      if (src[i] > max_code) {
-        throw std::invalid_argument("dequantise: code " + std::to_string(src[i]) + " exceeds " +
-                                    std::to_string(bits) + "-bit range");
-      }
-      dst[i] = dequantise(src[i], static_cast<int>(max_code));
+    // Codes above the maximum cannot come from quantise(); they indicate a bit-depth mix-up.
+    const std::uint16_t highest = *std::max_element(src, src + row_len);
+    if (highest > max_code) {
+      throw std::invalid_argument("dequantise: code " + std::to_string(highest) + " exceeds " + std::to_string(bits) +
+                                  "-bit range");
     }
+    for (int i = 0; i < row_len; ++i) dst[i] = value_of[src[i]];
   }
   return values;
 }

@@ -297,6 +297,13 @@ PanelEmission::PanelEmission(const Panel& panel, int output_bits)
   }
 }
 
+void PanelEmission::row(std::span<const std::uint16_t> codes, std::span<double> out) const {
+  if (history_) throw std::logic_error("PanelEmission::row: the panel has history; the light needs the previous codes");
+  if (codes.size() != out.size()) throw std::invalid_argument("PanelEmission::row: codes and out differ in size");
+  const std::array<const double*, 3> channel{table_.data(), table_.data() + codes_, table_.data() + 2 * codes_};
+  for (std::size_t k = 0; k < codes.size(); ++k) out[k] = channel[k % 3][codes[k]];
+}
+
 namespace {
 
 void check_gamma(double gamma, const char* name, const std::string& what) {

@@ -415,6 +415,22 @@ TEST(PanelModel, EmissionTableIsTheEmissionOfEveryCode) {
   }
 }
 
+TEST(PanelModel, EmissionOfARowIsTheEmissionOfEachCode) {
+  const Panel vive = parse_panel("vive");
+  const PanelEmission table(vive, 10);
+  std::vector<std::uint16_t> codes(3 * 17);
+  for (std::size_t k = 0; k < codes.size(); ++k) codes[k] = static_cast<std::uint16_t>((k * 389) % 1024);
+  std::vector<double> light(codes.size());
+  table.row(codes, light);
+  for (std::size_t k = 0; k < codes.size(); ++k) {
+    EXPECT_EQ(light[k], vive.emitted(codes[k] / 1023.0, 0.0, static_cast<int>(k % 3))) << k;
+  }
+  std::vector<double> shorter(codes.size() - 1);
+  EXPECT_THROW(table.row(codes, shorter), std::invalid_argument);
+  // With history the light of a code depends on the previous one, which a row of codes alone does not give.
+  EXPECT_THROW(PanelEmission(parse_panel("lcd"), 8).row(codes, light), std::logic_error);
+}
+
 TEST(PanelJson, RoundTripsEveryKind) {
   for (const char* spec : {"vive", "rift", "generic", "gamma:2.4", "gamma:2.1,2.2,2.3", "lcd",
                            "lcd:-0.05,0.1,0.5,0.01,2.4", "lcd:0,0,0.5,0,1.8"}) {

@@ -24,7 +24,8 @@ void to_encoded(std::span<const double> linear, std::span<double> encoded, Trans
 cv::Mat quantise(const cv::Mat& values, int bits);
 // The same for one value not NaN, with max_code = 2^bits - 1 (inline: the reference decoder quantises every sample).
 inline std::uint16_t quantise(double value, int max_code) {
-  return static_cast<std::uint16_t>(std::floor(std::clamp(value, 0.0, 1.0) * max_code + 0.5));
+  // The sum is >= 0.5, where truncation is floor: one conversion instead of floor's rounding-mode sequence.
+  return static_cast<std::uint16_t>(static_cast<int>(std::clamp(value, 0.0, 1.0) * max_code + 0.5));
 }
 // Q_b of the reduced frame (DESIGN §3 quantisation, deterministic at exact half-code ties). D of symmetric content
 // lands exactly on k + 1/2 codes (two codes averaged, a Nyquist checkerboard, an edge midway between two rows); D in

@@ -139,6 +139,8 @@ class PanelEmission {
   double operator()(std::uint16_t code, std::uint16_t previous_code, int channel) const {
     return history_ ? table_[code * codes_ + previous_code] : table_[static_cast<std::size_t>(channel) * codes_ + code];
   }
+  // The light of a run of interleaved RGB codes (starting at red) without history, as operator() per sample.
+  void row(std::span<const std::uint16_t> codes, std::span<double> out) const;
 
  private:
   std::size_t codes_ = 0;
