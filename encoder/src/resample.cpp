@@ -11,8 +11,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace trm {
 namespace {
@@ -63,6 +65,44 @@ std::vector<ClampedTaps> clamped_gaussian_taps(int full, int reduced, double sig
     }
   }
   return all;
+}
+
+// The outputs of D's horizontal pass that one polyphase loop can compute: where the full width is f times the reduced
+// one, the outputs [lo, hi) whose taps are the middle output's weights bit for bit over consecutive unclamped indexes
+// that advance by f per output (the interior; the clamped borders keep the per-output loop).
+struct PolyphaseRun {
+  int factor = 0;  // f; 0: no run
+  int lo = 0;
+  int hi = 0;
+  int first = 0;   // index of lo's first tap
+  const std::vector<double>* weight = nullptr;
+};
+
+PolyphaseRun polyphase_run(const std::vector<ClampedTaps>& taps, int full, int reduced) {
+  PolyphaseRun run;
+  if (full % reduced != 0) return run;
+  const int f = full / reduced;
+  const int middle = reduced / 2;
+  const ClampedTaps& model = taps[static_cast<std::size_t>(middle)];
+  const auto regular = [&](int x) {
+    const ClampedTaps& t = taps[static_cast<std::size_t>(x)];
+    if (t.weight.size() != model.weight.size()) return false;
+    const int first = model.index[0] + f * (x - middle);
+    for (std::size_t k = 0; k < t.weight.size(); ++k) {
+      if (t.index[k] != first + static_cast<int>(k)) return false;
+      if (std::memcmp(&t.weight[k], &model.weight[k], sizeof(double)) != 0) return false;
+    }
+    return true;
+  };
+  if (!regular(middle)) return run;
+  run.lo = middle;
+  while (run.lo > 0 && regular(run.lo - 1)) --run.lo;
+  run.hi = middle + 1;
+  while (run.hi < reduced && regular(run.hi)) ++run.hi;
+  run.factor = f;
+  run.first = model.index[0] + f * (run.lo - middle);
+  run.weight = &model.weight;
+  return run;
 }
 
 }  // namespace
@@ -168,12 +208,45 @@ cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, d
   // Horizontal pass: every full row -> reduced_width samples.
   // Both passes split their output rows over OpenCV's threads: each output sample is one sum in a fixed order, so the
   // doubles do not depend on the split.
+  //
+  // The interior (PolyphaseRun) is summed a tap at a time over all its outputs, from planes of the row by channel and
+  // phase (sample f j + p of channel c at plane c f + p, index j), so each tap is one contiguous multiply-add over
+  // the run that the compiler vectorises. Every output is still 0 + w_0 s_0 + w_1 s_1 + ... in tap order: the same
+  // doubles as the per-output loop.
+  const PolyphaseRun run = polyphase_run(col_taps, full.cols, reduced_width);
   cv::Mat horizontal(full.rows, reduced_width, full.type());
   cv::parallel_for_(cv::Range(0, full.rows), [&](const cv::Range& rows) {
+    const int f = run.factor;
+    const int run_length = run.hi - run.lo;
+    std::vector<double> planes(f > 0 ? static_cast<std::size_t>(channels) * full.cols : 0);
+    std::vector<double> sums(static_cast<std::size_t>(run_length));
     for (int y = rows.start; y < rows.end; ++y) {
       const double* src = full.ptr<double>(y);
       double* dst = horizontal.ptr<double>(y);
+      if (f > 0) {
+        for (int ch = 0; ch < channels; ++ch) {
+          for (int p = 0; p < f; ++p) {
+            double* plane = planes.data() + static_cast<std::size_t>(ch * f + p) * reduced_width;
+            for (int j = 0; j < reduced_width; ++j) plane[j] = src[(f * j + p) * channels + ch];
+          }
+        }
+        for (int ch = 0; ch < channels; ++ch) {
+          std::fill(sums.begin(), sums.end(), 0.0);
+          double* sum = sums.data();
+          for (std::size_t k = 0; k < run.weight->size(); ++k) {
+            const int q = run.first + static_cast<int>(k);  // >= 0: the run's indexes are unclamped
+            const double w = (*run.weight)[k];
+            const double* in = planes.data() + static_cast<std::size_t>(ch * f + q % f) * reduced_width + q / f;
+            for (int j = 0; j < run_length; ++j) sum[j] += w * in[j];
+          }
+          for (int j = 0; j < run_length; ++j) dst[(run.lo + j) * channels + ch] = sum[j];
+        }
+      }
       for (int x = 0; x < reduced_width; ++x) {
+        if (x == run.lo && run_length > 0) {
+          x = run.hi - 1;
+          continue;
+        }
         const ClampedTaps& taps = col_taps[static_cast<std::size_t>(x)];
         for (int ch = 0; ch < channels; ++ch) {
           double acc = 0.0;

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 namespace trm {
 namespace {
@@ -243,6 +245,58 @@ TEST(Downsample, MatchesDirectEvaluationForOddSizesAndTinyR) {
     const cv::Mat ours = downsample(full, w, h, sigma);
     const cv::Mat direct = direct_downsample(full, w, h, sigma);
     EXPECT_LE(max_abs_diff(ours, direct), 1e-13) << c.fw << "x" << c.fh << " r=" << c.r;
+  }
+}
+
+// D's passes in their defining order, one output at a time: each horizontal output 0 + w_0 s_0 + w_1 s_1 + ... over
+// its taps (clamped indexes), then each vertical output the same over the horizontal rows. downsample() must give
+// these doubles bit for bit whatever loop structure it computes them with (its interior runs a tap at a time).
+cv::Mat separable_in_tap_order(const cv::Mat& full, int w, int h, double sigma) {
+  const int ch = full.channels();
+  cv::Mat horizontal(full.rows, w, full.type());
+  for (int x = 0; x < w; ++x) {
+    const GaussianTaps taps = gaussian_taps(x, full.cols, w, sigma);
+    for (int y = 0; y < full.rows; ++y) {
+      for (int c = 0; c < ch; ++c) {
+        double acc = 0.0;
+        for (std::size_t k = 0; k < taps.weights.size(); ++k) {
+          const int i = std::clamp(taps.first_index + static_cast<int>(k), 0, full.cols - 1);
+          acc += taps.weights[k] * full.ptr<double>(y)[i * ch + c];
+        }
+        horizontal.ptr<double>(y)[x * ch + c] = acc;
+      }
+    }
+  }
+  cv::Mat out(h, w, full.type());
+  for (int y = 0; y < h; ++y) {
+    const GaussianTaps taps = gaussian_taps(y, full.rows, h, sigma);
+    for (int i = 0; i < w * ch; ++i) {
+      double acc = 0.0;
+      for (std::size_t k = 0; k < taps.weights.size(); ++k) {
+        const int j = std::clamp(taps.first_index + static_cast<int>(k), 0, full.rows - 1);
+        acc += taps.weights[k] * horizontal.ptr<double>(j)[i];
+      }
+      out.ptr<double>(y)[i] = acc;
+    }
+  }
+  return out;
+}
+
+TEST(Downsample, IsTheSeparableSumInTapOrderBitForBit) {
+  struct Case { int fw, fh; double r; int channels; };
+  for (const Case& c : {Case{2160, 6, 0.5, 3}, Case{200, 9, 0.25, 3}, Case{99, 7, 1.0 / 3.0, 1}, Case{97, 9, 0.5, 3},
+                        Case{64, 8, 0.5, 4}, Case{40, 5, 1.0, 3}, Case{12, 5, 0.5, 3}, Case{6, 4, 0.5, 2}}) {
+    const int w = reduced_size(c.fw, c.r), h = reduced_size(c.fh, c.r);
+    const double sigma = default_sigma(c.r);
+    const cv::Mat full = random_image(c.fw, c.fh, c.channels, 11u + c.fw);
+    const cv::Mat ours = downsample(full, w, h, sigma);
+    const cv::Mat oracle = separable_in_tap_order(full, w, h, sigma);
+    ASSERT_EQ(ours.size(), oracle.size());
+    std::size_t differ = 0;
+    for (int y = 0; y < h; ++y) {
+      differ += std::memcmp(ours.ptr(y), oracle.ptr(y), ours.cols * ours.elemSize()) != 0 ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0U) << c.fw << "x" << c.fh << " r=" << c.r << " channels " << c.channels;
   }
 }
 
