@@ -179,35 +179,61 @@ HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::Re
   return hn::MulAdd(sum, scale, scale);
 }
 
+// One vector of x^y into out.
+template <class D>
+HWY_INLINE void PowStore(D d, hn::Vec<D> vx, hn::Vec<D> vy, double* out) {
+  const hn::RebindToSigned<D> di;
+  const std::size_t lanes = hn::Lanes(d);
+  hn::Mask<decltype(di)> special;
+  auto result = PowVector(d, vx, vy, special);
+  if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
+    // The special operands a decoder meets most, black and full light, exactly as pow gives them:
+    // pow(+0, y) = +0 for y > 0 and pow(1, y) = 1 for every y.
+    const auto bits = hn::BitCast(di, vx);
+    const auto zero_base = hn::And(hn::Eq(bits, hn::Zero(di)),
+                                   hn::RebindMask(di, hn::And(hn::Gt(vy, hn::Zero(d)), hn::IsFinite(vy))));
+    const auto one_base = hn::RebindMask(di, hn::Eq(vx, hn::Set(d, 1.0)));
+    result = hn::IfThenElse(hn::RebindMask(d, zero_base), hn::Zero(d), result);
+    result = hn::IfThenElse(hn::RebindMask(d, one_base), hn::Set(d, 1.0), result);
+    special = hn::AndNot(hn::Or(zero_base, one_base), special);
+  }
+  if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
+    // From the vectors, not from x: out may be x.
+    HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
+    HWY_ALIGN double xs[hn::MaxLanes(d)];
+    HWY_ALIGN double ys[hn::MaxLanes(d)];
+    HWY_ALIGN double rs[hn::MaxLanes(d)];
+    hn::Store(hn::VecFromMask(di, special), di, marked);
+    hn::Store(vx, d, xs);
+    hn::Store(vy, d, ys);
+    hn::Store(result, d, rs);
+    for (std::size_t j = 0; j < lanes; ++j) {
+      if (marked[j] != 0) rs[j] = std::pow(xs[j], ys[j]);
+    }
+    result = hn::Load(d, rs);
+  }
+  hn::StoreU(result, d, out);
+}
+
 // y_step 0: y[0] for every element; 1: y[k].
 void KernelElements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
   const hn::ScalableTag<double> d;
-  const hn::RebindToSigned<decltype(d)> di;
   const std::size_t lanes = hn::Lanes(d);
   std::size_t k = 0;
   for (; k + lanes <= n; k += lanes) {
-    const auto vx = hn::LoadU(d, x + k);
-    const auto vy = y_step == 0 ? hn::Set(d, y[0]) : hn::LoadU(d, y + k);
-    hn::Mask<decltype(di)> special;
-    auto result = PowVector(d, vx, vy, special);
-    if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
-      // From the vectors, not from x: out may be x.
-      HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
-      HWY_ALIGN double xs[hn::MaxLanes(d)];
-      HWY_ALIGN double ys[hn::MaxLanes(d)];
-      HWY_ALIGN double rs[hn::MaxLanes(d)];
-      hn::Store(hn::VecFromMask(di, special), di, marked);
-      hn::Store(vx, d, xs);
-      hn::Store(vy, d, ys);
-      hn::Store(result, d, rs);
-      for (std::size_t j = 0; j < lanes; ++j) {
-        if (marked[j] != 0) rs[j] = std::pow(xs[j], ys[j]);
-      }
-      result = hn::Load(d, rs);
-    }
-    hn::StoreU(result, d, out + k);
+    PowStore(d, hn::LoadU(d, x + k), y_step == 0 ? hn::Set(d, y[0]) : hn::LoadU(d, y + k), out + k);
   }
-  libm_elements(x + k, y + k * y_step, y_step, out + k, n - k);
+  if (k == n) return;
+  // The tail as one more vector, its unused lanes 2^1 (no special path).
+  HWY_ALIGN double xs[hn::MaxLanes(d)];
+  HWY_ALIGN double ys[hn::MaxLanes(d)];
+  HWY_ALIGN double rs[hn::MaxLanes(d)];
+  for (std::size_t j = 0; j < lanes; ++j) {
+    xs[j] = k + j < n ? x[k + j] : 2.0;
+    ys[j] = k + j < n ? y[(k + j) * y_step] : 1.0;
+  }
+  PowStore(d, hn::Load(d, xs), hn::Load(d, ys), rs);
+  for (std::size_t j = 0; k + j < n; ++j) out[k + j] = rs[j];
 }
 
 // Each target checks its own kernel against std::pow at its first use (the C library might not be glibc 2.36's).
