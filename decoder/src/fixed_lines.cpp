@@ -70,7 +70,7 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
   const auto unit = hn::Set(du, plan.unit);
   // The reduced row's samples widened once, so the taps are 32-bit gathers.
   thread_local std::vector<std::uint32_t> wide;
-  wide.resize(row_samples + lanes);
+  wide.resize(row_samples + 2 * lanes);  // a window's second vector may reach past the row
   std::size_t i = 0;
   for (; i + lanes <= row_samples; i += lanes) hn::StoreU(hn::PromoteTo(du, hn::LoadU(d16, row + i)), du, wide.data() + i);
   for (; i < row_samples; ++i) wide[i] = row[i];
@@ -80,6 +80,24 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
       const auto window = hn::LoadU(du, wide.data() + windows->start[block]);
       const auto a = hn::TableLookupLanes(window, hn::IndicesFromVec(du, hn::LoadU(di, windows->left.data() + s)));
       const auto b = hn::TableLookupLanes(window, hn::IndicesFromVec(du, hn::LoadU(di, windows->right.data() + s)));
+      const auto w = hn::LoadU(du, plan.upper.data() + s);
+      hn::StoreU(hn::Add(hn::Mul(hn::Sub(unit, w), a), hn::Mul(w, b)), du, out + s);
+    }
+  }
+  if (const ColumnBlendPlan::Windows* windows = plan.double_windows_for(lanes); windows != nullptr && s + lanes <= n) {
+    const auto lane_mask = hn::Set(di, static_cast<std::int32_t>(lanes - 1));
+    const auto lanes_i = hn::Set(di, static_cast<std::int32_t>(lanes));
+    for (std::size_t block = 0; s + lanes <= n; s += lanes, ++block) {
+      const auto low = hn::LoadU(du, wide.data() + windows->start[block]);
+      const auto high = hn::LoadU(du, wide.data() + windows->start[block] + lanes);
+      const auto tap = [&](const std::int32_t* relative) {
+        const auto index = hn::LoadU(di, relative + s);
+        const auto lane = hn::IndicesFromVec(du, hn::And(index, lane_mask));
+        return hn::IfThenElse(hn::RebindMask(du, hn::Lt(index, lanes_i)), hn::TableLookupLanes(low, lane),
+                              hn::TableLookupLanes(high, lane));
+      };
+      const auto a = tap(windows->left.data());
+      const auto b = tap(windows->right.data());
       const auto w = hn::LoadU(du, plan.upper.data() + s);
       hn::StoreU(hn::Add(hn::Mul(hn::Sub(unit, w), a), hn::Mul(w, b)), du, out + s);
     }
@@ -1154,23 +1172,29 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
       plan.upper[s] = static_cast<std::uint32_t>(col.upper);
     }
   }
-  for (std::size_t i = 0; i < plan.windows.size(); ++i) {
-    const std::size_t width = std::size_t{4} << i;
+  // Blocks of `lanes` output samples, each with a window of `span` row samples from its first tap.
+  const auto build = [&](std::size_t lanes, std::size_t span) {
     ColumnBlendPlan::Windows w;
-    bool fits = true;
-    for (std::size_t start = 0; fits && start + width <= samples; start += width) {
+    for (std::size_t start = 0; start + lanes <= samples; start += lanes) {
       const auto first = std::min(*std::min_element(plan.left.begin() + static_cast<std::ptrdiff_t>(start),
-                                                    plan.left.begin() + static_cast<std::ptrdiff_t>(start + width)),
+                                                    plan.left.begin() + static_cast<std::ptrdiff_t>(start + lanes)),
                                   *std::min_element(plan.right.begin() + static_cast<std::ptrdiff_t>(start),
-                                                    plan.right.begin() + static_cast<std::ptrdiff_t>(start + width)));
+                                                    plan.right.begin() + static_cast<std::ptrdiff_t>(start + lanes)));
       w.start.push_back(first);
-      for (std::size_t s = start; s < start + width; ++s) {
+      for (std::size_t s = start; s < start + lanes; ++s) {
         w.left.push_back(plan.left[s] - first);
         w.right.push_back(plan.right[s] - first);
-        fits = fits && w.left.back() < static_cast<std::int32_t>(width) && w.right.back() < static_cast<std::int32_t>(width);
+        if (w.left.back() >= static_cast<std::int32_t>(span) || w.right.back() >= static_cast<std::int32_t>(span)) {
+          return ColumnBlendPlan::Windows{};
+        }
       }
     }
-    if (fits) plan.windows[i] = std::move(w);
+    return w;
+  };
+  for (std::size_t i = 0; i < plan.windows.size(); ++i) {
+    const std::size_t lanes = std::size_t{4} << i;
+    plan.windows[i] = build(lanes, lanes);
+    plan.double_windows[i] = build(lanes, 2 * lanes);  // also where the single fit, for the tests to take them
   }
   return plan;
 }

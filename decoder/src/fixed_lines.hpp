@@ -35,12 +35,18 @@ struct ColumnBlendPlan {
     std::vector<std::int32_t> right;
   };
   std::array<Windows, 3> windows;  // L = 4 << i
-  const Windows* windows_for(std::size_t lanes) const {
-    for (std::size_t i = 0; i < windows.size(); ++i) {
-      if ((std::size_t{4} << i) == lanes) return windows[i].start.empty() ? nullptr : &windows[i];
+  // Where L samples do not fit (r = 1/2 at L = 8, AVX2: a vector's taps span up to 9 row samples), windows of 2L
+  // samples read as two vectors, each tap taken from one of their permutations: taps in [0, 2L). The kernel takes the
+  // single windows where both fit.
+  std::array<Windows, 3> double_windows;
+  static const Windows* of_width(const std::array<Windows, 3>& set, std::size_t lanes) {
+    for (std::size_t i = 0; i < set.size(); ++i) {
+      if ((std::size_t{4} << i) == lanes) return set[i].start.empty() ? nullptr : &set[i];
     }
     return nullptr;
   }
+  const Windows* windows_for(std::size_t lanes) const { return of_width(windows, lanes); }
+  const Windows* double_windows_for(std::size_t lanes) const { return of_width(double_windows, lanes); }
 };
 
 // U's row blend, its rounding to uQb.U and the EOTF ROM interpolation (FixedKernels::linear_of_upsampled): node y_i

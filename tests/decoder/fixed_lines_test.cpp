@@ -471,8 +471,9 @@ TEST(FixedLines, OledDriveKernelAtOctaveAndBucketEnds) {
   }
 }
 
-// U's column blend through its windows (a vector's taps within one vector of row samples, permuted) and through the
-// gather, against the blend's formula, at a headset width and a narrow one with tails, on every instruction set.
+// U's column blend through its windows (a vector's taps within one vector of row samples, permuted), through its
+// double windows (two vectors) and through the gather, against the blend's formula, at a headset width and a narrow
+// one with tails, on every instruction set.
 TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
   std::mt19937_64 random(31);
   for (const auto& [width, r] : {std::pair{2160, 0.5}, std::pair{67, 0.25}, std::pair{67, 0.75}}) {
@@ -480,8 +481,11 @@ TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
     const fixed_detail::Geometry& g = kernels.geometry(cv::Size(width, 24));
     const fixed_detail::ColumnBlendPlan& plan = g.column_blend;
     ASSERT_FALSE(plan.left.empty());
-    fixed_detail::ColumnBlendPlan gather_copy = plan;
-    gather_copy.windows = {};
+    fixed_detail::ColumnBlendPlan double_copy = plan;
+    double_copy.windows = {};
+    const fixed_detail::ColumnBlendPlan& double_only = double_copy;
+    fixed_detail::ColumnBlendPlan gather_copy = double_copy;
+    gather_copy.double_windows = {};
     const fixed_detail::ColumnBlendPlan& gather_only = gather_copy;
     std::vector<std::uint16_t> row(3 * static_cast<std::size_t>(g.reduced.width));
     for (std::uint16_t& code : row) code = static_cast<std::uint16_t>(random() % 256);
@@ -495,15 +499,18 @@ TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
     for (const auto& w : plan.windows) some_windows = some_windows || !w.start.empty();
     if (width == 2160) {
       EXPECT_TRUE(some_windows) << "r = 1/2 at a headset width takes the windows on some width";
+      EXPECT_TRUE(plan.windows_for(8) == nullptr && plan.double_windows_for(8) != nullptr)
+          << "r = 1/2 at 8 lanes (AVX2) takes the double windows";
     }
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
       const TargetMock mock(target);
-      for (const fixed_detail::ColumnBlendPlan* p : {&plan, &gather_only}) {
+      for (const fixed_detail::ColumnBlendPlan* p : {&plan, &double_only, &gather_only}) {
         std::vector<std::uint32_t> out(n);
         fixed_detail::lines::blend_columns(row.data(), *p, n, out.data());
         for (std::size_t s = 0; s < n; ++s) {
           ASSERT_EQ(out[s], expected[s]) << hwy::TargetName(target) << " width " << width << " r " << r
-                                         << (p == &plan ? " windows" : " gather") << " sample " << s;
+                                         << (p == &plan ? " windows" : p == &double_only ? " double windows" : " gather")
+                                         << " sample " << s;
         }
       }
     }
