@@ -18,7 +18,32 @@
 HWY_BEFORE_NAMESPACE();
 namespace trm::fixed_detail::lines {
 namespace HWY_NAMESPACE {
+
+// (phase + step) mod 3 for phase < 3 and step < 3, without the division the modulo compiles to.
+inline std::size_t next_phase(std::size_t phase, std::size_t step) {
+  const std::size_t next = phase + step;
+  return next >= 3 ? next - 3 : next;
+}
 namespace hn = hwy::HWY_NAMESPACE;
+
+// table[index] of each 64-bit lane. On four lanes (AVX2) four 128-bit loads (each word with the next: the tables
+// LookupWords reads carry one word more) and an unpack: on the CPUs measured (Zen 3) a gather of four words costs
+// several times as much.
+#if HWY_TARGET != HWY_SCALAR
+template <class D>
+HWY_INLINE hn::Vec<D> LookupWords(D d, const std::int64_t* table, hn::Vec<D> index) {
+  if constexpr (hn::MaxLanes(d) == 4) {
+    HWY_ALIGN std::int64_t at[4];
+    hn::Store(index, d, at);
+    const hn::Half<D> dh;
+    const auto even = hn::Combine(d, hn::LoadU(dh, table + at[2]), hn::LoadU(dh, table + at[0]));
+    const auto odd = hn::Combine(d, hn::LoadU(dh, table + at[3]), hn::LoadU(dh, table + at[1]));
+    return hn::InterleaveLower(d, even, odd);
+  } else {
+    return hn::GatherIndex(d, table, index);
+  }
+}
+#endif
 
 // Scalar forms, for the tails (the same expressions as the vector bodies and as the stage functions).
 inline std::int64_t eotf_scalar(std::uint64_t blended, const EotfPlan& p) {
@@ -137,7 +162,7 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
     const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), p.blend_shift);     // uQb.U
     const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, p.weight_bits));
     const auto weight = hn::BitCast(di32, hn::And(upsampled, weight_mask));
-    const auto word = hn::GatherIndex(d, p.packed.data(), node);
+    const auto word = LookupWords(d, p.packed.data(), node);
     const auto y0 = hn::ShiftRight<32>(word);
     const auto step = hn::BitCast(di32, word);  // the low halves, which MulEven reads
     const auto exact = hn::Add(hn::ShiftLeftSame(y0, p.weight_bits), hn::MulEven(step, weight));
@@ -198,7 +223,7 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   const auto offset_mask = hn::Set(du, packed ? (std::uint32_t{1} << p.offset_bits) - 1 : 0u);
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
-  for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
+  for (; s + lanes <= n; s += lanes, phase = next_phase(phase, phase_step)) {
     const auto low = hn::LoadU(d64, linear + s);
     const auto high = hn::LoadU(d64, linear + s + half);
     const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero64), hn::Not(hn::Lt(v, limit64))); };
@@ -255,7 +280,7 @@ void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, s
   const auto exponent_bias = hn::Set(d, std::int64_t{1023} + m - 1);
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
-  for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
+  for (; s + lanes <= n; s += lanes, phase = next_phase(phase, phase_step)) {
     const auto x = hn::LoadU(d, linear + s);
     if (!hn::AllFalse(d, hn::Or(hn::Lt(x, zero), hn::Not(hn::Lt(x, limit))))) {  // outside the index: generic search
       for (std::size_t i = 0; i < lanes; ++i) out[s + i] = drive_scalar(linear[s + i], s + i, p);
@@ -602,7 +627,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto scaled = hn::ShiftLeftSame(offset, p.segments_per_octave_log2);
     const auto node = hn::Add(hn::ShiftLeftSame(region, p.segments_per_octave_log2), hn::Shr(scaled, scale_bits));
     const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
-    const auto word = hn::GatherIndex(d, p.target_packed.data(), node);
+    const auto word = LookupWords(d, p.target_packed.data(), node);
     const auto exact = hn::Add(hn::Shl(hn::ShiftRight<32>(word), scale_bits),
                                hn::MulEven(hn::BitCast(di32, word), hn::BitCast(di32, weight)));
     const auto rom_target = hn::Shr(hn::Add(exact, hn::Shl(unit, hn::Sub(scale_bits, unit))), scale_bits);
@@ -690,7 +715,7 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     const int j = rom.weight_bits;
     const auto node = hn::BitCast(d, hn::ShiftRightSame(code, j));
     const auto low = hn::BitCast(di32, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
-    const auto word = hn::GatherIndex(d, rom.packed.data(), node);
+    const auto word = LookupWords(d, rom.packed.data(), node);
     const auto y0 = hn::ShiftRight<32>(word);
     const auto step = hn::BitCast(di32, word);
     const auto exact = hn::Add(hn::ShiftLeftSame(y0, j), hn::MulEven(step, low));
@@ -714,6 +739,7 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     return hn::IfThenElse(hn::Gt(i, lane_mask), hn::TableLookupLanes(rom_high, lane), hn::TableLookupLanes(rom_low, lane));
   };
   auto weight_sum = zero;
+  std::uint64_t underflow_count = 0;  // counted here, not through `tally` (a store per vector)
   for (; x + lanes <= pixels; x += lanes) {
     hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
     hn::LoadInterleaved3(d, previous + 3 * x, pr, pg, pb);
@@ -755,11 +781,12 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
                                                                          hn::BitCast(du32, e_fraction)), linear_half),
                                                      p.linear_frac_bits));
     const auto result = hn::IfThenElse(still, one, hn::IfThenZeroElse(underflow, w));
-    tally.underflow += hn::CountTrue(d, underflow);
+    underflow_count += hn::CountTrue(d, underflow);
     weight_sum = hn::Add(weight_sum, result);
     hn::StoreU(result, d, weight + x);
   }
   tally.weight_sum += hn::GetLane(hn::SumOfLanes(d, weight_sum));
+  tally.underflow += underflow_count;
 #endif
   for (; x < pixels; ++x) weight[x] = weight_scalar(previous + 3 * x, alpha + 3 * x, kernels, tally);
 }
@@ -783,6 +810,7 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
     return t;
   }();
   auto dropped = zero;
+  std::uint64_t clipped_count = 0;
   auto magnitude_sum = zero;
   auto magnitude_max = zero;
   std::size_t phase = 0;
@@ -791,7 +819,7 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
   // lanes / 3 + 1 pixels: one load of the pixels from s / 3 and a lane permutation, where that load stays within the
   // n / 3 weights; else a gather.
   const std::size_t pixels = n / 3;
-  for (; s + lanes <= n; s += lanes, phase = (phase + phase_step) % 3) {
+  for (; s + lanes <= n; s += lanes, phase = next_phase(phase, phase_step)) {
     const auto pixel = hn::LoadU(d, third.data() + phase);
     const auto w = s / 3 + lanes <= pixels
                        ? hn::TableLookupLanes(hn::LoadU(d, weight + s / 3), hn::IndicesFromVec(d, pixel))
@@ -807,13 +835,14 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
     const auto product = hn::MulEven(hn::BitCast(di32, w), hn::BitCast(di32, rho));
     const auto sum = hn::Add(hn::LoadU(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), p.residual_frac_bits));
     const auto clamped = hn::Min(hn::Max(sum, zero), one);
-    tally.clipped += hn::CountTrue(d, hn::Not(hn::Eq(clamped, sum)));
+    clipped_count += hn::CountTrue(d, hn::Not(hn::Eq(clamped, sum)));
     dropped = hn::Add(dropped, hn::Sub(hn::Max(sum, clamped), hn::Min(sum, clamped)));
     const auto magnitude = hn::Max(rho, hn::Neg(rho));
     magnitude_sum = hn::Add(magnitude_sum, magnitude);
     magnitude_max = hn::Max(magnitude_max, magnitude);
     hn::StoreU(clamped, d, shown + s);
   }
+  tally.clipped += clipped_count;
   tally.dropped_sum += hn::GetLane(hn::SumOfLanes(d, dropped));
   tally.residual_abs_sum += hn::GetLane(hn::SumOfLanes(d, magnitude_sum));
   tally.residual_abs_max = std::max(tally.residual_abs_max, hn::GetLane(hn::MaxOfLanes(d, magnitude_max)));
@@ -862,7 +891,8 @@ namespace {
 // node << 32 | (step mod 2^32) per word, or nothing where a node leaves [0, 2^31) or a step int32.
 std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64_t>& node,
                                                     const std::vector<std::int64_t>& step) {
-  std::vector<std::int64_t> packed(node.size());
+  // One word more than the ROM: LookupWords reads each word with the next.
+  std::vector<std::int64_t> packed(node.size() + 1, 0);
   for (std::size_t i = 0; i < node.size(); ++i) {
     if (node[i] < 0 || node[i] > INT32_MAX || step[i] < INT32_MIN || step[i] > INT32_MAX) return std::nullopt;
     packed[i] = static_cast<std::int64_t>((static_cast<std::uint64_t>(node[i]) << 32) |
