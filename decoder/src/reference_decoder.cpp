@@ -286,10 +286,14 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     // The LCD drive of the row a chunk at a time (the same doubles as panel.drive per sample).
     constexpr int kChunk = 255;
     std::array<PanelDriveSample, kChunk> samples;
+    double* next_row = next_drive.ptr<double>(y);
+    double* target_row = record ? lcd_target.ptr<double>(y) : nullptr;
+    double* contributed_row = contributed.empty() ? nullptr : contributed.ptr<double>(y);
+    std::uint8_t* unreachable_row = record ? lcd_unreachable.ptr<std::uint8_t>(y) : nullptr;
+    bool nan = false;
+    std::size_t unreachable = 0;
     for (int k = 0; k < row_len; ++k) {
-      const int ch = k % 3;
       const double x_t = x_row[k];
-      const double v_prev = vp_row[k];
       if (k % kChunk == 0) {
         const auto count = static_cast<std::size_t>(std::min(kChunk, row_len - k));
         panel.lcd.drive(std::span<const double>(x_row + k, count), std::span<const double>(xp_row + k, count),
@@ -297,21 +301,23 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
       }
       const PanelDriveSample& sample = samples[static_cast<std::size_t>(k % kChunk)];
       v_row[k] = sample.v;
-      if (std::isnan(sample.v)) {
-        tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
-        q_row[k] = 0;
-      } else {
-        q_row[k] = quantise(sample.v, top);
-      }
-      const auto previous_code = static_cast<std::uint16_t>(std::lround(v_prev * top));
-      e_row[k] = emission_(q_row[k], previous_code, ch);
-      next_drive.ptr<double>(y)[k] = dequantise(q_row[k], top);
-      if (record) lcd_target.ptr<double>(y)[k] = sample.target;
-      if (!contributed.empty()) contributed.ptr<double>(y)[k] = sample.reachable ? x_t : sample.contributed;
+      nan |= std::isnan(sample.v);
+      q_row[k] = std::isnan(sample.v) ? std::uint16_t{0} : quantise(sample.v, top);
+      next_row[k] = dequantise(q_row[k], top);
+      if (target_row != nullptr) target_row[k] = sample.target;
+      if (contributed_row != nullptr) contributed_row[k] = sample.reachable ? x_t : sample.contributed;
       if (sample.reachable) continue;
-      ++tallies.unreachable[static_cast<std::size_t>(y)];
-      if (record) lcd_unreachable.ptr<std::uint8_t>(y)[k] = 255;
+      ++unreachable;
+      if (unreachable_row != nullptr) unreachable_row[k] = 255;
       if (residual_row != nullptr) residual_row[k] += x_t - sample.contributed;
+    }
+    if (nan) tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
+    tallies.unreachable[static_cast<std::size_t>(y)] = unreachable;
+    // The light of each code after the previous one in a pass of its own, so that the table's loads (512 KiB at
+    // 8-bit output, more than a core's L2) are in flight together.
+    for (int k = 0; k < row_len; ++k) {
+      const auto previous_code = static_cast<std::uint16_t>(std::lround(vp_row[k] * top));
+      e_row[k] = emission_(q_row[k], previous_code, k % 3);
     }
   };
 

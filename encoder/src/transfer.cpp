@@ -217,17 +217,23 @@ cv::Mat dequantise(const cv::Mat& codes, int bits) {
   }
   cv::Mat values(codes.size(), CV_MAKETYPE(CV_64F, codes.channels()));
   const int row_len = codes.cols * codes.channels();
+  // Codes above the maximum cannot come from quantise(); they indicate a bit-depth mix-up. Checked before any work,
+  // so that the lookups below, on OpenCV's threads, throw nothing.
   for (int y = 0; y < codes.rows; ++y) {
     const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
-    double* dst = values.ptr<double>(y);
-    // Codes above the maximum cannot come from quantise(); they indicate a bit-depth mix-up.
     const std::uint16_t highest = *std::max_element(src, src + row_len);
     if (highest > max_code) {
       throw std::invalid_argument("dequantise: code " + std::to_string(highest) + " exceeds " + std::to_string(bits) +
                                   "-bit range");
     }
-    for (int i = 0; i < row_len; ++i) dst[i] = value_of[src[i]];
   }
+  cv::parallel_for_(cv::Range(0, codes.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
+      double* dst = values.ptr<double>(y);
+      for (int i = 0; i < row_len; ++i) dst[i] = value_of[src[i]];
+    }
+  });
   return values;
 }
 
