@@ -121,7 +121,9 @@ HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::Re
   using VD = hn::Vec<D>;
   using VI = hn::Vec<decltype(di)>;
   const VI ix = hn::BitCast(di, x);
-  const VI top_y = hn::And(hn::ShiftRight<52>(hn::BitCast(di, y)), hn::Set(di, 0x7ff));
+  // Logical shifts where a mask follows (AVX2 has no 64-bit arithmetic shift).
+  const hn::RebindToUnsigned<D> du;
+  const VI top_y = hn::BitCast(di, hn::And(hn::ShiftRight<52>(hn::BitCast(du, y)), hn::Set(du, 0x7ff)));
   // glibc: top12(x) - 1 >= 0x7fe (x <= 0 or subnormal, inf, NaN, or negative), |y| outside [2^-65, 2^63) or NaN.
   special = hn::Or(hn::Lt(ix, hn::Set(di, std::int64_t{0x0010000000000000})),
                    hn::Gt(ix, hn::Set(di, std::int64_t{0x7fefffffffffffff})));
@@ -129,8 +131,18 @@ HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::Re
 
   // log_inline: x = 2^k z with z in [0x1.6955p-1, 0x1.6955p0), log x = k ln2 + log c + log1p(z / c - 1).
   const VI tmp = hn::Sub(ix, hn::Set(di, std::int64_t{0x3fe6955500000000}));
+#if HWY_TARGET == HWY_AVX2
+  // AVX2 has no 64-bit arithmetic shift nor int64 -> double conversion (Highway emulates them in 5 and 7 operations).
+  // The entry's bits by a logical shift; k = tmp >> 52 (arithmetic) exactly, as the top 12 bits in offset binary
+  // (k + 2048) placed in a double's mantissa at exponent 52 and that double less 2^52 + 2048.
+  const VI entry = hn::BitCast(di, hn::And(hn::ShiftRight<45>(hn::BitCast(du, tmp)), hn::Set(du, 127)));
+  const VD kd = hn::Sub(hn::BitCast(d, hn::Xor(hn::ShiftRight<52>(hn::BitCast(du, tmp)),
+                                               hn::Set(du, std::uint64_t{0x4330000000000800}))),
+                        hn::Set(d, 0x1.00000000008p52));
+#else
   const VI entry = hn::And(hn::ShiftRight<45>(tmp), hn::Set(di, 127));
   const VD kd = hn::ConvertTo(d, hn::ShiftRight<52>(tmp));  // arithmetic shift: k
+#endif
   const VD z = hn::BitCast(d, hn::Sub(ix, hn::And(tmp, hn::Set(di, static_cast<std::int64_t>(0xfffULL << 52)))));
   VD invc, logc, logctail;
   LookupLog(d, entry, invc, logc, logctail);
@@ -157,7 +169,7 @@ HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::Re
   const VD ehi = hn::Mul(y, log_hi);
   const VD elo = hn::MulAdd(y, log_lo, hn::MulSub(log_hi, y, ehi));
   // exp_inline's own special cases: |ehi| < 2^-54 (x^y rounds to 1 +- ulp) or >= 512 (over/underflow).
-  const VI abstop = hn::And(hn::ShiftRight<52>(hn::BitCast(di, ehi)), hn::Set(di, 0x7ff));
+  const VI abstop = hn::BitCast(di, hn::And(hn::ShiftRight<52>(hn::BitCast(du, ehi)), hn::Set(du, 0x7ff)));
   special = hn::Or(special, hn::Or(hn::Lt(abstop, hn::Set(di, 0x3c9)), hn::Gt(abstop, hn::Set(di, 0x407))));
 
   // exp_inline: exp(ehi + elo) = 2^(k/128) exp(r), r = ehi - k ln2/128 + elo.
