@@ -95,9 +95,13 @@ std::pair<double, double> summarise_residual(const cv::Mat& residual) {
   const cv::Mat flat = residual.reshape(1);
   for (int y = 0; y < flat.rows; ++y) {
     const double* row = flat.ptr<double>(y);
-    // The sum in raster order; the maximum (order-free: std::max never takes a NaN in) in a loop of its own, where
-    // it stays in a register instead of lengthening the sum's dependency chain through memory.
-    for (int k = 0; k < flat.cols; ++k) sum += std::abs(row[k]);
+    // The sum in raster order, over the nonzero magnitudes only: adding +0 to a sum >= +0 leaves it as it is, and rho
+    // is zero wherever beta was not clipped, so the chain of dependent additions is as long as the clipped samples.
+    // The maximum (order-free: std::max never takes a NaN in) in a loop of its own, where it stays in a register.
+    for (int k = 0; k < flat.cols; ++k) {
+      const double magnitude = std::abs(row[k]);
+      if (magnitude != 0.0) sum += magnitude;
+    }
     double row_max = 0.0;
     for (int k = 0; k < flat.cols; ++k) row_max = std::max(row_max, std::abs(row[k]));
     max_abs = std::max(max_abs, row_max);
