@@ -41,14 +41,15 @@ includes=(-I"$root/link/include" -I"$root/link/src" -I"$root/encoder/include" -I
           -I"$root/hw_models/include" -I"$root/fixed_point/include" -I"$root/tools/src" -I"$root/tools/rig/include" -isystem /usr/include/opencv4 -isystem /usr/include/eigen3)
 common=(-std=c++20 -g -O1 -fno-omit-frame-pointer "${includes[@]}")
 sanitize=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
-libs=(-lcharls -ldeflate -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lopencv_core)
+libs=(-lcharls -ldeflate -lhwy -lopencv_videoio -lopencv_imgcodecs -lopencv_imgproc -lopencv_core)
 header_dirs=("$root/link/include" "$root/link/src" "$root/encoder/include" "$root/encoder/src"
              "$root/hw_models/include" "$root/fixed_point/include" "$root/tools/src" "$root/tools/rig/include")
 
 # The library sources the targets reach, instrumented for coverage (fuzzer-no-link) and the sanitizers,
 # compiled TRM_FUZZ_JOBS at a time and rebuilt when a source or a project header is newer.
 sources=("$root"/link/src/*.cpp "$root"/encoder/src/{frame,transfer,sources,media}.cpp "$root"/encoder/src/scenes/scene_support.cpp
-         "$root"/hw_models/src/panel.cpp "$root"/hw_models/src/lc_response.cpp "$root"/hw_models/src/lc_second_order.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp)
+         "$root"/hw_models/src/panel.cpp "$root"/hw_models/src/lc_response.cpp "$root"/hw_models/src/lc_second_order.cpp "$root"/tools/src/view_size.cpp "$root"/tools/rig/src/{protocol,feeder,transport}.cpp
+         "$root"/fixed_point/src/vector_pow.cpp)
 compile() {  # SOURCE OBJECT HEADER_DIR... -- FLAGS...
   local src=$1 obj=$2 dirs=()
   shift 2
@@ -67,8 +68,12 @@ for src in "${sources[@]}"; do
   obj="$build/obj/${rel//\//_}"
   obj=${obj%.cpp}.o
   objects+=("$obj")
+  # The vector pow includes itself once per instruction set (Highway's foreach_target) and fuses only where glibc's
+  # pow does (fixed_point/CMakeLists.txt).
+  extra=()
+  [[ $src == */vector_pow.cpp ]] && extra=(-I"$root/fixed_point/src" -ffp-contract=off)
   wait_for_slot
-  compile "$src" "$obj" "${header_dirs[@]}" -- -fsanitize=fuzzer-no-link &
+  compile "$src" "$obj" "${header_dirs[@]}" -- -fsanitize=fuzzer-no-link "${extra[@]}" &
 done
 for program in "${targets[@]/#/fuzz_}" make_corpus make_seeds; do
   wait_for_slot

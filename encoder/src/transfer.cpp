@@ -210,10 +210,12 @@ cv::Mat dequantise(const cv::Mat& codes, int bits) {
   if (codes.depth() != CV_16U) throw std::invalid_argument("dequantise: expected a CV_16U matrix");
   require_bits(bits);
   const int max_code = (1 << bits) - 1;
-  // Every code's value once (the same division), then a lookup per sample.
-  std::vector<double> value_of(static_cast<std::size_t>(max_code) + 1);
-  for (int code = 0; code <= max_code; ++code) {
-    value_of[static_cast<std::size_t>(code)] = dequantise(static_cast<std::uint16_t>(code), max_code);
+  // Every code's value once (the same division), then a lookup per sample; a view with fewer samples than codes
+  // (a small one at 16 bits) divides per sample instead.
+  const bool by_table = codes.total() * static_cast<std::size_t>(codes.channels()) > static_cast<std::size_t>(max_code);
+  std::vector<double> value_of(by_table ? static_cast<std::size_t>(max_code) + 1 : 0);
+  for (std::size_t code = 0; code < value_of.size(); ++code) {
+    value_of[code] = dequantise(static_cast<std::uint16_t>(code), max_code);
   }
   cv::Mat values(codes.size(), CV_MAKETYPE(CV_64F, codes.channels()));
   const int row_len = codes.cols * codes.channels();
@@ -221,9 +223,9 @@ cv::Mat dequantise(const cv::Mat& codes, int bits) {
   // so that the lookups below, on OpenCV's threads, throw nothing.
   for (int y = 0; y < codes.rows; ++y) {
     const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
-    const std::uint16_t highest = *std::max_element(src, src + row_len);
-    if (highest > max_code) {
-      throw std::invalid_argument("dequantise: code " + std::to_string(highest) + " exceeds " + std::to_string(bits) +
+    if (*std::max_element(src, src + row_len) > max_code) {
+      const std::uint16_t first = *std::find_if(src, src + row_len, [&](std::uint16_t c) { return c > max_code; });
+      throw std::invalid_argument("dequantise: code " + std::to_string(first) + " exceeds " + std::to_string(bits) +
                                   "-bit range");
     }
   }
@@ -231,7 +233,11 @@ cv::Mat dequantise(const cv::Mat& codes, int bits) {
     for (int y = rows.start; y < rows.end; ++y) {
       const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
       double* dst = values.ptr<double>(y);
-      for (int i = 0; i < row_len; ++i) dst[i] = value_of[src[i]];
+      if (by_table) {
+        for (int i = 0; i < row_len; ++i) dst[i] = value_of[src[i]];
+      } else {
+        for (int i = 0; i < row_len; ++i) dst[i] = dequantise(src[i], max_code);
+      }
     }
   });
   return values;

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace trm {
@@ -126,6 +127,29 @@ TEST(Quantise, EveryCodeSurvivesDequantiseQuantise) {
     ASSERT_EQ(values.type(), CV_64FC3);
     EXPECT_DOUBLE_EQ(values.at<cv::Vec3d>(n - 1)[0], 1.0);
     EXPECT_EQ(cv::norm(quantise(values, bits), codes, cv::NORM_INF), 0.0) << bits << " bits";
+  }
+}
+
+// Through its table (more samples than codes) and by division (fewer), every value is code / (2^bits - 1) exactly,
+// and a code out of range is named in the refusal.
+TEST(Quantise, DequantiseIsTheDivisionByTableAndDirectly) {
+  for (const int bits : {8, 16}) {
+    const int top = (1 << bits) - 1;
+    cv::Mat codes(3, 700, CV_16UC1);
+    for (int k = 0; k < static_cast<int>(codes.total()); ++k) codes.at<std::uint16_t>(k) = static_cast<std::uint16_t>((k * 7919) % (top + 1));
+    const cv::Mat values = dequantise(codes, bits);
+    for (int k = 0; k < static_cast<int>(codes.total()); ++k) {
+      ASSERT_EQ(values.at<double>(k), codes.at<std::uint16_t>(k) / static_cast<double>(top)) << bits << " bits, " << k;
+    }
+  }
+  cv::Mat bad(2, 600, CV_16UC1, cv::Scalar(3));
+  bad.at<std::uint16_t>(1, 10) = 300;
+  bad.at<std::uint16_t>(1, 20) = 999;
+  try {
+    dequantise(bad, 8);
+    FAIL() << "code 300 at 8 bits was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("code 300 exceeds 8-bit range"), std::string::npos) << e.what();
   }
 }
 
