@@ -24,7 +24,12 @@ constexpr double kSrgbOffset = 0.055;
 constexpr double kSrgbExponent = 2.4;
 constexpr double kPureGamma = 2.2;
 
-double clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
+// std::clamp(x, 0, 1) (NaN and -0 pass through as with it) written as two selects, which GCC vectorises where the
+// loops below call it (it branches on std::clamp's nested ternary).
+inline double clamp01(double x) {
+  const double above_zero = x < 0.0 ? 0.0 : x;
+  return 1.0 < above_zero ? 1.0 : above_zero;
+}
 
 void require_double(const cv::Mat& m, const char* what) {
   if (m.depth() != CV_64F) {
@@ -89,20 +94,14 @@ namespace transfer_detail {
 // to_linear's element-wise steps around the pows, compiled for AVX2 too and chosen at run time (GCC's function
 // multi-versioning): the compiler vectorises them four doubles wide there. Only the ISA's width changes (no FMA in
 // the AVX2 clone: "avx2" does not enable it), so the doubles are the baseline's.
-// std::clamp(x, 0, 1) as two selects, which GCC vectorises (it branches on std::clamp's nested ternary).
-inline double clamp01_select(double x) {
-  const double above_zero = x < 0.0 ? 0.0 : x;
-  return 1.0 < above_zero ? 1.0 : above_zero;
-}
-
 [[gnu::target_clones("avx2", "default")]] void srgb_pow_bases(const double* in, double* base, std::size_t n) {
-  for (std::size_t k = 0; k < n; ++k) base[k] = clamp01_select(in[k]);
+  for (std::size_t k = 0; k < n; ++k) base[k] = clamp01(in[k]);
   for (std::size_t k = 0; k < n; ++k) base[k] = (base[k] + kSrgbOffset) / (1.0 + kSrgbOffset);
 }
 
 [[gnu::target_clones("avx2", "default")]] void srgb_linear_select(const double* in, const double* power, double* out,
                                                                   std::size_t n) {
-  for (std::size_t k = 0; k < n; ++k) out[k] = clamp01_select(in[k]);
+  for (std::size_t k = 0; k < n; ++k) out[k] = clamp01(in[k]);
   for (std::size_t k = 0; k < n; ++k) {
     const double v = out[k];
     const double linear_segment = v / kSrgbSlope;

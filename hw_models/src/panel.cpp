@@ -101,6 +101,22 @@ Panel oled_panel(const std::string& name, const std::array<double, 3>& gamma) {
 
 namespace lcd_detail {
 
+// M(v, v_prev) = m as a v^2 + b v + c = 0 (Eq. 7), for LcdPanel::solve and its vector loop alike.
+struct Quadratic {
+  double a;
+  double b;
+  double c;
+};
+inline Quadratic quadratic(double p1, double p2, double p3, double p4, double m, double v_prev) {
+  return {p1, p2 * v_prev + p3, p1 * v_prev * v_prev + p3 * v_prev + p4 - m};
+}
+
+// A root the solve takes: within [0, 1] up to kRangeTolerance (& rather than &&: no branch, for the vector loop).
+inline bool in_drive_range(double v) { return (v >= -kRangeTolerance) & (v <= 1.0 + kRangeTolerance); }
+
+// The pair's average, clamped at 0: what LcdPanel::target raises to 1/gamma.
+inline double pair_average(double x_t, double x_prev) { return std::max(0.5 * (x_t + x_prev), 0.0); }
+
 // LcdPanel::solve's common case (a root of M(v, v_prev) = m in range, taken as solve takes it) for a run of samples,
 // every expression as solve writes it, as selects instead of branches so that the compiler vectorises the run; GCC's
 // function multi-versioning compiles it for AVX2 too (four doubles a vector, no FMA: the same doubles). v is NaN
@@ -109,10 +125,7 @@ namespace lcd_detail {
                                                               const double* m, const double* v_prev, double* v,
                                                               std::size_t n) {
   for (std::size_t k = 0; k < n; ++k) {
-    const double vp = v_prev[k];
-    const double a = p1;
-    const double b = p2 * vp + p3;
-    const double c = p1 * vp * vp + p3 * vp + p4 - m[k];
+    const auto [a, b, c] = quadratic(p1, p2, p3, p4, m[k], v_prev[k]);
     const bool linear = std::abs(a) <= kNegligibleQuadratic * std::abs(b);
     const double linear_root = -c / b;
     const double disc = b * b - 4.0 * a * c;
@@ -120,9 +133,7 @@ namespace lcd_detail {
     const double q = -0.5 * (b + sign_b * std::sqrt(disc));
     const double continuous_root = c / q;
     const double root = linear ? linear_root : continuous_root;
-    // & rather than &&: no short circuit, no branch.
-    const bool in_range = (root >= -kRangeTolerance) & (root <= 1.0 + kRangeTolerance);
-    const bool taken = in_range & (linear | ((disc >= 0.0) & (q != 0.0)));
+    const bool taken = in_drive_range(root) & (linear | ((disc >= 0.0) & (q != 0.0)));
     const double above_zero = root < 0.0 ? 0.0 : root;
     const double clamped = (1.0 < above_zero ? 1.0 : above_zero) + 0.0;
     v[k] = taken ? clamped : std::numeric_limits<double>::quiet_NaN();
@@ -137,12 +148,8 @@ double LcdPanel::merge(double v_t, double v_prev) const {
 }
 
 LcdPanel::Solution LcdPanel::solve(double m, double v_prev) const {
-  // M(v, v_prev) = m as a v^2 + b v + c = 0.
-  const double a = p1;
-  const double b = p2 * v_prev + p3;
-  const double c = p1 * v_prev * v_prev + p3 * v_prev + p4 - m;
-
-  const auto in_range = [](double v) { return v >= -kRangeTolerance && v <= 1.0 + kRangeTolerance; };
+  const auto [a, b, c] = lcd_detail::quadratic(p1, p2, p3, p4, m, v_prev);
+  const auto in_range = [](double v) { return lcd_detail::in_drive_range(v); };
   // Clamps the few-ulp overshoot allowed by in_range; "+ 0.0" turns -0 (from -c / b with c = 0) into +0.
   const auto reachable = [](double v) { return Solution{std::clamp(v, 0.0, 1.0) + 0.0, true}; };
 
@@ -194,7 +201,7 @@ LcdPanel::Solution LcdPanel::solve(double m, double v_prev) const {
 double LcdPanel::luminance(double merged) const { return std::pow(std::max(merged, 0.0), gamma); }
 
 double LcdPanel::target(double x_t, double x_prev) const {
-  return std::pow(std::max(0.5 * (x_t + x_prev), 0.0), 1.0 / gamma);
+  return std::pow(lcd_detail::pair_average(x_t, x_prev), 1.0 / gamma);
 }
 
 // The pair (v_{t-1}, v_t) is seen as the merged value M(v_t, v_{t-1}) with luminance M^gamma, the time average of the
@@ -221,20 +228,19 @@ void LcdPanel::drive(std::span<const double> x_t, std::span<const double> x_prev
     throw std::invalid_argument("LcdPanel::drive: x_t, x_prev, v_prev and out differ in size");
   }
   constexpr std::size_t kChunk = 256;
-  std::array<double, kChunk> targets;
+  std::array<double, kChunk> m;  // target() of each sample
+  std::array<double, kChunk> solved;
   for (std::size_t start = 0; start < x_t.size(); start += kChunk) {
     const std::size_t count = std::min(kChunk, x_t.size() - start);
-    for (std::size_t k = 0; k < count; ++k) targets[k] = std::max(0.5 * (x_t[start + k] + x_prev[start + k]), 0.0);
-    const std::span<double> target(targets.data(), count);
-    pow_elements(target, 1.0 / gamma, target);  // target()
-    std::array<double, kChunk> solved;
-    lcd_detail::solve_in_range(p1, p2, p3, p4, targets.data(), v_prev.data() + start, solved.data(), count);
+    for (std::size_t k = 0; k < count; ++k) m[k] = lcd_detail::pair_average(x_t[start + k], x_prev[start + k]);
+    pow_elements(std::span<const double>(m.data(), count), 1.0 / gamma, std::span<double>(m.data(), count));
+    lcd_detail::solve_in_range(p1, p2, p3, p4, m.data(), v_prev.data() + start, solved.data(), count);
     for (std::size_t k = 0; k < count; ++k) {
       const std::size_t i = start + k;
       if (std::isnan(solved[k])) {
-        out[i] = drive_to(target[k], x_t[i], x_prev[i], v_prev[i]);
+        out[i] = drive_to(m[k], x_t[i], x_prev[i], v_prev[i]);
       } else {
-        out[i] = PanelDriveSample{.v = solved[k], .target = target[k], .reachable = true, .contributed = x_t[i]};
+        out[i] = PanelDriveSample{.v = solved[k], .target = m[k], .reachable = true, .contributed = x_t[i]};
       }
     }
   }

@@ -6,7 +6,8 @@
 // that algorithm operation for operation in Highway vectors — the same tables, the same roundings, fused exactly
 // where glibc's FMA build fuses — so every lane is the double std::pow returns. Lanes on glibc's special paths (x
 // zero, subnormal, negative, infinite or NaN; y outside [2^-65, 2^63); x^y within 2^-54 of 1 or beyond 2^±512) and
-// every element on CPUs without FMA (where glibc takes its other build) are computed by std::pow itself.
+// every element on CPUs without FMA (where glibc takes its other build) are computed by std::pow itself, except the
+// two a decoder meets on every black or full-light sample, pow(+0, y > 0) = +0 and pow(1, y) = 1, set in the vector.
 //
 // Each instruction set's first call checks its kernel against std::pow on 16384 inputs at four exponents and uses
 // std::pow alone if one differs (a C library whose pow is another algorithm). tests/fixed_point/vector_pow_test.cpp
