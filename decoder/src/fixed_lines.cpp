@@ -43,6 +43,24 @@ HWY_INLINE hn::Vec<D> LookupWords(D d, const std::int64_t* table, hn::Vec<D> ind
     return hn::GatherIndex(d, table, index);
   }
 }
+
+// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1] (the table carries one word more).
+template <class D>
+HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn::Vec<D>& first, hn::Vec<D>& second) {
+  const auto at = hn::Add(index, index);
+  if constexpr (hn::MaxLanes(d) == 4) {
+    HWY_ALIGN std::int64_t offset[4];
+    hn::Store(at, d, offset);
+    const hn::Half<D> dh;
+    const auto even = hn::Combine(d, hn::LoadU(dh, table + offset[2]), hn::LoadU(dh, table + offset[0]));
+    const auto odd = hn::Combine(d, hn::LoadU(dh, table + offset[3]), hn::LoadU(dh, table + offset[1]));
+    first = hn::InterleaveLower(d, even, odd);
+    second = hn::InterleaveUpper(d, even, odd);
+  } else {
+    first = hn::GatherIndex(d, table, at);
+    second = hn::GatherIndex(d, table + 1, at);
+  }
+}
 #endif
 
 // Scalar forms, for the tails (the same expressions as the vector bodies and as the stage functions).
@@ -524,24 +542,35 @@ HWY_INLINE hn::Vec<D> LcdBinarySearch(D d, const LcdPlan& p, hn::Vec<D> target_s
   return lo;
 }
 
-// The same code through LcdPlan::index (one gather): row is the row's number (v_{t-1}, or 2^o for the held row).
+// LcdPlan::index's word for target m in the row numbered row (v_{t-1}, or 2^o for the held row): its index.
 template <class D>
-HWY_INLINE hn::Vec<D> LcdIndexSearch(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> row) {
+HWY_INLINE hn::Vec<D> LcdIndexAt(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> row) {
   const hn::RebindToUnsigned<D> du;
   const hn::Repartition<std::uint32_t, decltype(du)> du32;
-  const hn::Rebind<std::int32_t, D> d32;
+  const auto q = hn::ShiftRightSame(hn::Min(hn::Max(target, hn::Zero(d)), hn::Set(d, p.one)), p.index_shift);
+  return hn::Add(hn::BitCast(d, hn::MulEven(hn::BitCast(du32, row),
+                                            hn::BitCast(du32, hn::Set(du, static_cast<std::uint64_t>(p.index_buckets))))),
+                 q);
+}
+
+// The code of target m from its LcdPlan::index word.
+template <class D>
+HWY_INLINE hn::Vec<D> LcdIndexCode(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> word) {
   const auto t = hn::Min(hn::Max(target, hn::Zero(d)), hn::Set(d, p.one));
-  const auto q = hn::ShiftRightSame(t, p.index_shift);
-  const auto at = hn::Add(hn::BitCast(d, hn::MulEven(hn::BitCast(du32, row),
-                                                     hn::BitCast(du32, hn::Set(du, static_cast<std::uint64_t>(p.index_buckets))))),
-                          q);
-  const auto* words = reinterpret_cast<const std::int32_t*>(p.index.data());
-  const auto word = hn::PromoteTo(du, hn::BitCast(hn::RebindToUnsigned<decltype(d32)>(),
-                                                  hn::GatherIndex(d32, words, hn::BitCast(d32, hn::TruncateTo(hn::RebindToUnsigned<decltype(d32)>(), hn::BitCast(du, at))))));
-  const auto low = hn::BitCast(du, hn::Sub(t, hn::ShiftLeftSame(q, p.index_shift)));
-  const auto offset = hn::And(word, hn::Set(du, (std::uint64_t{1} << p.index_offset_bits) - 1));
+  const auto low = hn::And(t, hn::Set(d, (std::int64_t{1} << p.index_shift) - 1));
+  const auto offset = hn::And(word, hn::Set(d, (std::int64_t{1} << p.index_offset_bits) - 1));
   const auto k = hn::ShiftRightSame(word, p.index_offset_bits);
-  return hn::BitCast(d, hn::Add(k, hn::IfThenZeroElse(hn::Lt(low, offset), hn::Set(du, std::uint64_t{1}))));
+  return hn::Add(k, hn::IfThenZeroElse(hn::Lt(low, offset), hn::Set(d, std::int64_t{1})));
+}
+
+// The same code through LcdPlan::index (one gather).
+template <class D>
+HWY_INLINE hn::Vec<D> LcdIndexSearch(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> row) {
+  const hn::Rebind<std::int32_t, D> d32;
+  const hn::Rebind<std::uint32_t, D> du32;
+  const auto at = hn::BitCast(d32, hn::TruncateTo(du32, hn::BitCast(hn::RebindToUnsigned<D>(), LcdIndexAt(d, p, target, row))));
+  const auto* words = reinterpret_cast<const std::int32_t*>(p.index.data());
+  return LcdIndexCode(d, p, target, hn::BitCast(d, hn::PromoteTo(hn::RebindToUnsigned<D>(), hn::BitCast(du32, hn::GatherIndex(d32, words, at)))));
 }
 #endif
 
@@ -610,14 +639,17 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
   const auto exponent_bias = hn::Set(d, std::int64_t{1023});
   const auto held_row = hn::Set(d, p.width);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
-  for (; s + lanes <= n; s += lanes) {
-    const auto x = hn::LoadU(d, wanted + s);
-    // The eye's first frame takes the pixel as held at x_t (FixedKernels::lcd_drive): x_{t-1} = x_t, and v_{t-1} is
-    // found below from the held row.
-    const auto x_previous = held ? x : hn::PromoteTo(d, hn::LoadU(d32, previous_linear + s));
-    const auto sum = hn::Add(x, x_previous);
-    // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one.
-    // (A sum of 2 or more reads 1, not the ROM: its code is clamped as evaluate_raw clamps it.)
+  // The eye's first frame takes the pixel as held at x_t (FixedKernels::lcd_drive): x_{t-1} = x_t, and v_{t-1} is
+  // found from the held row.
+  const auto previous_of = [&](std::size_t i, const auto x) {
+    return held ? x : hn::PromoteTo(d, hn::LoadU(d32, previous_linear + i));
+  };
+  const auto previous_row = [&](std::size_t i) {
+    return hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d8, previous_code + i))));
+  };
+  // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one.
+  // (A sum of 2 or more reads 1, not the ROM: its code is clamped as evaluate_raw clamps it.)
+  const auto target_of = [&](const auto sum) {
     const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), p.target_shift), top_code);
     const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
     const auto bottom = hn::Lt(lead, bottom_bits);
@@ -631,19 +663,14 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto exact = hn::Add(hn::Shl(hn::ShiftRight<32>(word), scale_bits),
                                hn::MulEven(hn::BitCast(di32, word), hn::BitCast(di32, weight)));
     const auto rom_target = hn::Shr(hn::Add(exact, hn::Shl(unit, hn::Sub(scale_bits, unit))), scale_bits);
-    const auto target = hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
-    const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target), scale));
-    // The largest k with M(T_k, v_{t-1}) <= m: through the per-row index, else the binary search of the row.
-    const bool indexed = !p.index.empty();
-    const auto search = [&](const auto row) {
-      return indexed ? LcdIndexSearch(d, p, target, row)
-                     : LcdBinarySearch(d, p, target_scaled, hn::ShiftLeftSame(row, p.width_log2));
-    };
-    const auto j = held ? search(held_row)
-                        : hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d8, previous_code + s))));
-    const auto lo = search(j);
-    const auto end_dark = hn::GatherIndex(d, p.end_dark.data(), j);
-    const auto end_bright = hn::GatherIndex(d, p.end_bright.data(), j);
+    return hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
+  };
+  // Given v_{t-1} = j and lo, the largest k with M(T_k, v_{t-1}) <= m: the unreachable ends, the codes and the
+  // frame stores.
+  const auto finish = [&](std::size_t i, const auto x, const auto x_previous, const auto sum, const auto j,
+                          const auto lo) {
+    hn::Vec<decltype(d)> end_dark, end_bright;
+    LookupPairs(d, p.ends.data(), j, end_dark, end_bright);
     const auto below = hn::Lt(sum, hn::Add(end_dark, end_dark));
     const auto above = hn::Gt(sum, hn::Add(end_bright, end_bright));
     const auto clamped = hn::Or(below, above);
@@ -651,11 +678,63 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto end = hn::IfThenElse(above, end_bright, end_dark);
     const auto contributed = hn::IfThenElse(clamped, hn::Sub(hn::Add(end, end), x_previous), x);
     unreachable += hn::CountTrue(d, clamped);
-    if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + s);
+    if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + i);
     const auto stored = p.contributed ? contributed : x;
-    hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + s);
-    hn::StoreU(hn::TruncateTo(d8, hn::BitCast(du, drive)), d8, previous_code + s);
-    hn::StoreU(hn::BitCast(d32, hn::TruncateTo(du32h, hn::BitCast(du, stored))), d32, previous_linear + s);
+    hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + i);
+    hn::StoreU(hn::TruncateTo(d8, hn::BitCast(du, drive)), d8, previous_code + i);
+    hn::StoreU(hn::BitCast(d32, hn::TruncateTo(du32h, hn::BitCast(du, stored))), d32, previous_linear + i);
+  };
+  if (p.index.empty()) {  // the binary search of the merge table's row
+    for (; s + lanes <= n; s += lanes) {
+      const auto x = hn::LoadU(d, wanted + s);
+      const auto x_previous = previous_of(s, x);
+      const auto sum = hn::Add(x, x_previous);
+      const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target_of(sum)), scale));
+      const auto search = [&](const auto row) {
+        return LcdBinarySearch(d, p, target_scaled, hn::ShiftLeftSame(row, p.width_log2));
+      };
+      const auto j = held ? search(held_row) : previous_row(s);
+      finish(s, x, x_previous, sum, j, search(j));
+    }
+  } else {
+    // Through the index, a chunk of samples at a time in passes: m and the words' places, then the words by scalar
+    // loads, then the codes. The index is larger than a core's L2 cache and a vector's lookups would stall its
+    // chain; loads independent of each other overlap.
+    constexpr std::size_t kChunk = 256;
+    HWY_ALIGN std::int64_t targets[kChunk];
+    HWY_ALIGN std::int64_t words[kChunk];
+    HWY_ALIGN std::int64_t held_codes[kChunk];
+    const std::uint32_t* index = p.index.data();
+    const auto look_up = [&](std::size_t m) {
+      for (std::size_t i = 0; i < m; ++i) words[i] = index[words[i]];
+    };
+    while (s + lanes <= n) {
+      const std::size_t m = std::min(kChunk, (n - s) / lanes * lanes);
+      for (std::size_t i = 0; i < m; i += lanes) {
+        const auto x = hn::LoadU(d, wanted + s + i);
+        const auto target = target_of(hn::Add(x, previous_of(s + i, x)));
+        hn::Store(target, d, targets + i);
+        hn::Store(LcdIndexAt(d, p, target, held ? held_row : previous_row(s + i)), d, words + i);
+      }
+      look_up(m);
+      if (held) {  // v_{t-1} from the held row, then the code from v_{t-1}'s row
+        for (std::size_t i = 0; i < m; i += lanes) {
+          const auto target = hn::Load(d, targets + i);
+          const auto j = LcdIndexCode(d, p, target, hn::Load(d, words + i));
+          hn::Store(j, d, held_codes + i);
+          hn::Store(LcdIndexAt(d, p, target, j), d, words + i);
+        }
+        look_up(m);
+      }
+      for (std::size_t i = 0; i < m; i += lanes) {
+        const auto x = hn::LoadU(d, wanted + s + i);
+        const auto x_previous = previous_of(s + i, x);
+        const auto j = held ? hn::Load(d, held_codes + i) : previous_row(s + i);
+        finish(s + i, x, x_previous, hn::Add(x, x_previous), j,
+               LcdIndexCode(d, p, hn::Load(d, targets + i), hn::Load(d, words + i)));
+      }
+      s += m;
+    }
   }
 #endif
   for (; s < n; ++s) {
@@ -1037,8 +1116,12 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     l.segments_per_octave_log2 = target.segments_per_octave_log2();
     while ((1 << l.steps) < l.width) ++l.steps;
     l.merge = kernels.lcd_merge_table_;
-    l.end_dark = kernels.lcd_end_luminance_[0];
-    l.end_bright = kernels.lcd_end_luminance_[1];
+    const auto& [end_dark, end_bright] = kernels.lcd_end_luminance_;
+    for (std::size_t v = 0; v < end_dark.size() && v < end_bright.size(); ++v) {
+      l.ends.push_back(end_dark[v]);
+      l.ends.push_back(end_bright[v]);
+    }
+    l.ends.push_back(0);
     l.contributed = c.decoder.lcd_history == LcdHistory::Contributed;
     const std::vector<std::int64_t>& rom = target.rom();
     std::vector<std::int64_t> step(rom.size(), 0);
@@ -1051,8 +1134,8 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
                       !target.shape().output_signed && target.shape().input_bits <= 30 && l.bottom_region_bits >= 1 &&
                       rom.size() >= (static_cast<std::size_t>(target.shape().octaves) << l.segments_per_octave_log2) &&
                       l.merge.size() >= static_cast<std::size_t>(l.width * (l.width + 1)) &&  // the held row too
-                      l.end_dark.size() == static_cast<std::size_t>(l.width) &&
-                      l.end_bright.size() == static_cast<std::size_t>(l.width);
+                      end_dark.size() == static_cast<std::size_t>(l.width) &&
+                      end_bright.size() == static_cast<std::size_t>(l.width);
     if (fits) {
       l.target_packed = std::move(*packed);
       lcd_search_index(l);

@@ -174,8 +174,9 @@ struct LcdPlan {
   int width_log2 = 0;
   int top = 0;                      // 2^o - 1
   int steps = 0;                    // binary search steps that cover [0, top]
-  std::vector<std::int64_t> end_dark;    // M(0, v_{t-1})^gamma, uQ/sQ.F
-  std::vector<std::int64_t> end_bright;  // M(1, v_{t-1})^gamma
+  // Per v_{t-1}: M(0, v_{t-1})^gamma and M(1, v_{t-1})^gamma (uQ/sQ.F) side by side, the unreachable ends, read as
+  // one 128-bit load per sample; one padding word at the end.
+  std::vector<std::int64_t> ends;
   bool contributed = false;              // LcdHistory::Contributed: x_{t-1} stored is the contributed value
   // The search in one gather (lcd_search_index): per row r (v_{t-1} = r, then the held row) the code is the number
   // of its thresholds U_k = ceil(merge[r][k] / scale) (the smallest target m with m scale >= merge) at or below m.
