@@ -14,6 +14,7 @@
 #include <bit>
 #include <cstdint>
 #include <iterator>
+#include <type_traits>
 
 HWY_BEFORE_NAMESPACE();
 namespace trm::fixed_detail::lines {
@@ -41,6 +42,27 @@ HWY_INLINE hn::Vec<D> LookupWords(D d, const std::int64_t* table, hn::Vec<D> ind
     return hn::InterleaveLower(d, even, odd);
   } else {
     return hn::GatherIndex(d, table, index);
+  }
+}
+
+// A ROM word's interpolation, rounded half up: (node 2^j + step w + 2^(j-1)) >> j of word = node << 32 | step
+// (packed_rom) and weight w in [0, 2^j). In unsigned lanes, exact because packed_rom takes only ROMs whose every node
+// and node + step are non-negative, so the sum (a weighted mean of the two times 2^j) is; AVX2 has no 64-bit
+// arithmetic shift. j is one count for all lanes or a vector of counts.
+template <class D, class Shift>
+HWY_INLINE hn::Vec<D> InterpolateWord(D d, hn::Vec<D> word, hn::Vec<D> weight, Shift j) {
+  const hn::RebindToUnsigned<D> du;
+  const hn::Repartition<std::int32_t, D> di32;
+  const auto node = hn::ShiftRight<32>(hn::BitCast(du, word));
+  const auto step_times_weight = hn::BitCast(du, hn::MulEven(hn::BitCast(di32, word), hn::BitCast(di32, weight)));
+  if constexpr (std::is_same_v<Shift, int>) {
+    const auto exact = hn::Add(hn::ShiftLeftSame(node, j), step_times_weight);
+    return hn::BitCast(d, hn::ShiftRightSame(hn::Add(exact, hn::Set(du, std::uint64_t{1} << (j - 1))), j));
+  } else {
+    const auto shift = hn::BitCast(du, j);
+    const auto one = hn::Set(du, std::uint64_t{1});
+    const auto exact = hn::Add(hn::Shl(node, shift), step_times_weight);
+    return hn::BitCast(d, hn::Shr(hn::Add(exact, hn::Shl(one, hn::Sub(shift, one))), shift));
   }
 }
 
@@ -172,19 +194,14 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   const auto upper_weight = hn::BitCast(du32, hn::Set(du, upper));
   const auto blend_half = hn::Set(du, std::uint64_t{1} << (p.blend_shift - 1));
   const auto weight_mask = hn::Set(du, (std::uint64_t{1} << p.weight_bits) - 1);
-  const auto weight_half = hn::Set(d, std::int64_t{1} << (p.weight_bits - 1));
   for (; s + lanes <= n; s += lanes) {
     const auto t = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, top + s)));
     const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s)));
     const auto blended = hn::Add(hn::MulEven(lower_weight, t), hn::MulEven(upper_weight, b));  // uQb.2W
     const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), p.blend_shift);     // uQb.U
     const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, p.weight_bits));
-    const auto weight = hn::BitCast(di32, hn::And(upsampled, weight_mask));
-    const auto word = LookupWords(d, p.packed.data(), node);
-    const auto y0 = hn::ShiftRight<32>(word);
-    const auto step = hn::BitCast(di32, word);  // the low halves, which MulEven reads
-    const auto exact = hn::Add(hn::ShiftLeftSame(y0, p.weight_bits), hn::MulEven(step, weight));
-    hn::StoreU(hn::ShiftRightSame(hn::Add(exact, weight_half), p.weight_bits), d, out + s);
+    const auto weight = hn::BitCast(d, hn::And(upsampled, weight_mask));
+    hn::StoreU(InterpolateWord(d, LookupWords(d, p.packed.data(), node), weight, p.weight_bits), d, out + s);
   }
 #endif
   for (; s < n; ++s) {
@@ -659,10 +676,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto scaled = hn::ShiftLeftSame(offset, p.segments_per_octave_log2);
     const auto node = hn::Add(hn::ShiftLeftSame(region, p.segments_per_octave_log2), hn::Shr(scaled, scale_bits));
     const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
-    const auto word = LookupWords(d, p.target_packed.data(), node);
-    const auto exact = hn::Add(hn::Shl(hn::ShiftRight<32>(word), scale_bits),
-                               hn::MulEven(hn::BitCast(di32, word), hn::BitCast(di32, weight)));
-    const auto rom_target = hn::Shr(hn::Add(exact, hn::Shl(unit, hn::Sub(scale_bits, unit))), scale_bits);
+    const auto rom_target = InterpolateWord(d, LookupWords(d, p.target_packed.data(), node), weight, scale_bits);
     return hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
   };
   // Given v_{t-1} = j and lo, the largest k with M(T_k, v_{t-1}) <= m: the unreachable ends, the codes and the
@@ -793,12 +807,8 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   const auto interpolate = [&](const ShiftedRomPlan& rom, const auto code) {
     const int j = rom.weight_bits;
     const auto node = hn::BitCast(d, hn::ShiftRightSame(code, j));
-    const auto low = hn::BitCast(di32, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
-    const auto word = LookupWords(d, rom.packed.data(), node);
-    const auto y0 = hn::ShiftRight<32>(word);
-    const auto step = hn::BitCast(di32, word);
-    const auto exact = hn::Add(hn::ShiftLeftSame(y0, j), hn::MulEven(step, low));
-    return hn::ShiftRightSame(hn::Add(exact, hn::Set(d, std::int64_t{1} << (j - 1))), j);
+    const auto low = hn::BitCast(d, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
+    return InterpolateWord(d, LookupWords(d, rom.packed.data(), node), low, j);
   };
   const auto luma = [&](const auto r, const auto g, const auto b) {
     const auto sum = hn::Add(hn::Add(hn::MulEven(luma_weight_r, hn::BitCast(du32, r)),
@@ -967,13 +977,16 @@ namespace trm::fixed_detail {
 
 namespace {
 
-// node << 32 | (step mod 2^32) per word, or nothing where a node leaves [0, 2^31) or a step int32.
+// node << 32 | (step mod 2^32) per word, or nothing where a node leaves [0, 2^31), a step int32 or node + step
+// [0, ...) (InterpolateWord's shifts are unsigned).
 std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64_t>& node,
                                                     const std::vector<std::int64_t>& step) {
   // One word more than the ROM: LookupWords reads each word with the next.
   std::vector<std::int64_t> packed(node.size() + 1, 0);
   for (std::size_t i = 0; i < node.size(); ++i) {
-    if (node[i] < 0 || node[i] > INT32_MAX || step[i] < INT32_MIN || step[i] > INT32_MAX) return std::nullopt;
+    if (node[i] < 0 || node[i] > INT32_MAX || step[i] < INT32_MIN || step[i] > INT32_MAX || node[i] + step[i] < 0) {
+      return std::nullopt;
+    }
     packed[i] = static_cast<std::int64_t>((static_cast<std::uint64_t>(node[i]) << 32) |
                                           static_cast<std::uint32_t>(step[i]));
   }
