@@ -188,20 +188,23 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   const hn::RebindToUnsigned<decltype(d)> du;
   const hn::Rebind<std::uint32_t, decltype(du)> d32h;  // half-width loads of the uQb.W rows
   const hn::Repartition<std::uint32_t, decltype(du)> du32;
-  const hn::Repartition<std::int32_t, decltype(d)> di32;
   const std::size_t lanes = hn::Lanes(d);
+  // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
+  const int blend_shift = p.blend_shift;
+  const int weight_bits = p.weight_bits;
+  const std::int64_t* packed = p.packed.data();
   const auto lower_weight = hn::BitCast(du32, hn::Set(du, p.unit - upper));
   const auto upper_weight = hn::BitCast(du32, hn::Set(du, upper));
-  const auto blend_half = hn::Set(du, std::uint64_t{1} << (p.blend_shift - 1));
-  const auto weight_mask = hn::Set(du, (std::uint64_t{1} << p.weight_bits) - 1);
+  const auto blend_half = hn::Set(du, std::uint64_t{1} << (blend_shift - 1));
+  const auto weight_mask = hn::Set(du, (std::uint64_t{1} << weight_bits) - 1);
   for (; s + lanes <= n; s += lanes) {
     const auto t = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, top + s)));
     const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s)));
     const auto blended = hn::Add(hn::MulEven(lower_weight, t), hn::MulEven(upper_weight, b));  // uQb.2W
-    const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), p.blend_shift);     // uQb.U
-    const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, p.weight_bits));
+    const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), blend_shift);       // uQb.U
+    const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, weight_bits));
     const auto weight = hn::BitCast(d, hn::And(upsampled, weight_mask));
-    hn::StoreU(InterpolateWord(d, LookupWords(d, p.packed.data(), node), weight, p.weight_bits), d, out + s);
+    hn::StoreU(InterpolateWord(d, LookupWords(d, packed, node), weight, weight_bits), d, out + s);
   }
 #endif
   for (; s < n; ++s) {
@@ -559,24 +562,34 @@ HWY_INLINE hn::Vec<D> LcdBinarySearch(D d, const LcdPlan& p, hn::Vec<D> target_s
   return lo;
 }
 
+// LcdPlan::index's shape, in locals (the compiler reloads a plan's fields after every vector store).
+struct LcdIndexShape {
+  explicit LcdIndexShape(const LcdPlan& p)
+      : one(p.one), shift(p.index_shift), offset_bits(p.index_offset_bits), buckets(p.index_buckets) {}
+  std::int64_t one;
+  int shift;
+  int offset_bits;
+  std::int64_t buckets;
+};
+
 // LcdPlan::index's word for target m in the row numbered row (v_{t-1}, or 2^o for the held row): its index.
 template <class D>
-HWY_INLINE hn::Vec<D> LcdIndexAt(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> row) {
+HWY_INLINE hn::Vec<D> LcdIndexAt(D d, const LcdIndexShape& p, hn::Vec<D> target, hn::Vec<D> row) {
   const hn::RebindToUnsigned<D> du;
   const hn::Repartition<std::uint32_t, decltype(du)> du32;
-  const auto q = hn::ShiftRightSame(hn::Min(hn::Max(target, hn::Zero(d)), hn::Set(d, p.one)), p.index_shift);
+  const auto q = hn::ShiftRightSame(hn::Min(hn::Max(target, hn::Zero(d)), hn::Set(d, p.one)), p.shift);
   return hn::Add(hn::BitCast(d, hn::MulEven(hn::BitCast(du32, row),
-                                            hn::BitCast(du32, hn::Set(du, static_cast<std::uint64_t>(p.index_buckets))))),
+                                            hn::BitCast(du32, hn::Set(du, static_cast<std::uint64_t>(p.buckets))))),
                  q);
 }
 
 // The code of target m from its LcdPlan::index word.
 template <class D>
-HWY_INLINE hn::Vec<D> LcdIndexCode(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> word) {
+HWY_INLINE hn::Vec<D> LcdIndexCode(D d, const LcdIndexShape& p, hn::Vec<D> target, hn::Vec<D> word) {
   const auto t = hn::Min(hn::Max(target, hn::Zero(d)), hn::Set(d, p.one));
-  const auto low = hn::And(t, hn::Set(d, (std::int64_t{1} << p.index_shift) - 1));
-  const auto offset = hn::And(word, hn::Set(d, (std::int64_t{1} << p.index_offset_bits) - 1));
-  const auto k = hn::ShiftRightSame(word, p.index_offset_bits);
+  const auto low = hn::And(t, hn::Set(d, (std::int64_t{1} << p.shift) - 1));
+  const auto offset = hn::And(word, hn::Set(d, (std::int64_t{1} << p.offset_bits) - 1));
+  const auto k = hn::ShiftRightSame(word, p.offset_bits);
   return hn::Add(k, hn::IfThenZeroElse(hn::Lt(low, offset), hn::Set(d, std::int64_t{1})));
 }
 
@@ -585,9 +598,10 @@ template <class D>
 HWY_INLINE hn::Vec<D> LcdIndexSearch(D d, const LcdPlan& p, hn::Vec<D> target, hn::Vec<D> row) {
   const hn::Rebind<std::int32_t, D> d32;
   const hn::Rebind<std::uint32_t, D> du32;
-  const auto at = hn::BitCast(d32, hn::TruncateTo(du32, hn::BitCast(hn::RebindToUnsigned<D>(), LcdIndexAt(d, p, target, row))));
+  const LcdIndexShape shape(p);
+  const auto at = hn::BitCast(d32, hn::TruncateTo(du32, hn::BitCast(hn::RebindToUnsigned<D>(), LcdIndexAt(d, shape, target, row))));
   const auto* words = reinterpret_cast<const std::int32_t*>(p.index.data());
-  return LcdIndexCode(d, p, target, hn::BitCast(d, hn::PromoteTo(hn::RebindToUnsigned<D>(), hn::BitCast(du32, hn::GatherIndex(d32, words, at)))));
+  return LcdIndexCode(d, shape, target, hn::BitCast(d, hn::PromoteTo(hn::RebindToUnsigned<D>(), hn::BitCast(du32, hn::GatherIndex(d32, words, at)))));
 }
 #endif
 
@@ -656,6 +670,13 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
   const auto exponent_bias = hn::Set(d, std::int64_t{1023});
   const auto held_row = hn::Set(d, p.width);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
+  // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
+  const int target_shift = p.target_shift;
+  const int segments_log2 = p.segments_per_octave_log2;
+  const std::int64_t* target_packed = p.target_packed.data();
+  const std::int64_t* ends = p.ends.data();
+  const bool contributed_stored = p.contributed;
+  const LcdIndexShape shape(p);
   // The eye's first frame takes the pixel as held at x_t (FixedKernels::lcd_drive): x_{t-1} = x_t, and v_{t-1} is
   // found from the held row.
   const auto previous_of = [&](std::size_t i, const auto x) {
@@ -667,16 +688,16 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one.
   // (A sum of 2 or more reads 1, not the ROM: its code is clamped as evaluate_raw clamps it.)
   const auto target_of = [&](const auto sum) {
-    const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), p.target_shift), top_code);
+    const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), target_shift), top_code);
     const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
     const auto bottom = hn::Lt(lead, bottom_bits);
     const auto scale_bits = hn::IfThenElse(bottom, bottom_bits, lead);
     const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
     const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
-    const auto scaled = hn::ShiftLeftSame(offset, p.segments_per_octave_log2);
-    const auto node = hn::Add(hn::ShiftLeftSame(region, p.segments_per_octave_log2), hn::Shr(scaled, scale_bits));
+    const auto scaled = hn::ShiftLeftSame(offset, segments_log2);
+    const auto node = hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits));
     const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
-    const auto rom_target = InterpolateWord(d, LookupWords(d, p.target_packed.data(), node), weight, scale_bits);
+    const auto rom_target = InterpolateWord(d, LookupWords(d, target_packed, node), weight, scale_bits);
     return hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
   };
   // Given v_{t-1} = j and lo, the largest k with M(T_k, v_{t-1}) <= m: the unreachable ends, the codes and the
@@ -684,7 +705,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto finish = [&](std::size_t i, const auto x, const auto x_previous, const auto sum, const auto j,
                           const auto lo) {
     hn::Vec<decltype(d)> end_dark, end_bright;
-    LookupPairs(d, p.ends.data(), j, end_dark, end_bright);
+    LookupPairs(d, ends, j, end_dark, end_bright);
     const auto below = hn::Lt(sum, hn::Add(end_dark, end_dark));
     const auto above = hn::Gt(sum, hn::Add(end_bright, end_bright));
     const auto clamped = hn::Or(below, above);
@@ -693,7 +714,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto contributed = hn::IfThenElse(clamped, hn::Sub(hn::Add(end, end), x_previous), x);
     unreachable += hn::CountTrue(d, clamped);
     if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + i);
-    const auto stored = p.contributed ? contributed : x;
+    const auto stored = contributed_stored ? contributed : x;
     hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + i);
     hn::StoreU(hn::TruncateTo(d8, hn::BitCast(du, drive)), d8, previous_code + i);
     hn::StoreU(hn::BitCast(d32, hn::TruncateTo(du32h, hn::BitCast(du, stored))), d32, previous_linear + i);
@@ -728,15 +749,15 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
         const auto x = hn::LoadU(d, wanted + s + i);
         const auto target = target_of(hn::Add(x, previous_of(s + i, x)));
         hn::Store(target, d, targets + i);
-        hn::Store(LcdIndexAt(d, p, target, held ? held_row : previous_row(s + i)), d, words + i);
+        hn::Store(LcdIndexAt(d, shape, target, held ? held_row : previous_row(s + i)), d, words + i);
       }
       look_up(m);
       if (held) {  // v_{t-1} from the held row, then the code from v_{t-1}'s row
         for (std::size_t i = 0; i < m; i += lanes) {
           const auto target = hn::Load(d, targets + i);
-          const auto j = LcdIndexCode(d, p, target, hn::Load(d, words + i));
+          const auto j = LcdIndexCode(d, shape, target, hn::Load(d, words + i));
           hn::Store(j, d, held_codes + i);
-          hn::Store(LcdIndexAt(d, p, target, j), d, words + i);
+          hn::Store(LcdIndexAt(d, shape, target, j), d, words + i);
         }
         look_up(m);
       }
@@ -745,7 +766,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
         const auto x_previous = previous_of(s + i, x);
         const auto j = held ? hn::Load(d, held_codes + i) : previous_row(s + i);
         finish(s + i, x, x_previous, hn::Add(x, x_previous), j,
-               LcdIndexCode(d, p, hn::Load(d, targets + i), hn::Load(d, words + i)));
+               LcdIndexCode(d, shape, hn::Load(d, targets + i), hn::Load(d, words + i)));
       }
       s += m;
     }
@@ -804,17 +825,29 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   const auto exponent_half = hn::Set(du, std::uint64_t{1} << (p.exponent_shift - 1));
   const auto fraction_mask = hn::Set(du, (std::uint64_t{1} << p.exp_input_frac_bits) - 1);
   const auto linear_half = hn::Set(du, std::uint64_t{1} << (p.linear_frac_bits - 1));
-  const auto interpolate = [&](const ShiftedRomPlan& rom, const auto code) {
+  // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
+  const int luma_shift = p.luma_shift;
+  const int reciprocal_input_bits = p.reciprocal_input_bits;
+  const int exponent_shift = p.exponent_shift;
+  const int exp_input_frac_bits = p.exp_input_frac_bits;
+  const int linear_frac_bits = p.linear_frac_bits;
+  struct Rom {
+    const std::int64_t* packed;
+    int weight_bits;
+  };
+  const Rom reciprocal{p.reciprocal.packed.data(), p.reciprocal.weight_bits};
+  const Rom exp_fraction{p.exp_fraction.packed.data(), p.exp_fraction.weight_bits};
+  const auto interpolate = [&](const Rom& rom, const auto code) {
     const int j = rom.weight_bits;
     const auto node = hn::BitCast(d, hn::ShiftRightSame(code, j));
     const auto low = hn::BitCast(d, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
-    return InterpolateWord(d, LookupWords(d, rom.packed.data(), node), low, j);
+    return InterpolateWord(d, LookupWords(d, rom.packed, node), low, j);
   };
   const auto luma = [&](const auto r, const auto g, const auto b) {
     const auto sum = hn::Add(hn::Add(hn::MulEven(luma_weight_r, hn::BitCast(du32, r)),
                                      hn::MulEven(luma_weight_g, hn::BitCast(du32, g))),
                              hn::MulEven(luma_weight_b, hn::BitCast(du32, b)));
-    return hn::BitCast(d, hn::ShiftRightSame(hn::Add(sum, luma_half), p.luma_shift));  // uQ1.F
+    return hn::BitCast(d, hn::ShiftRightSame(hn::Add(sum, luma_half), luma_shift));  // uQ1.F
   };
   const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero), hn::Gt(v, one)); };
   // exp(-i) of i in [0, 15]: where a vector holds 8 words (AVX-512), the 16-word ROM is two vectors, read by lane
@@ -853,22 +886,22 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     const auto lead_u = hn::BitCast(du, hn::IfThenElse(still, zero, lead));
     const auto below = hn::Sub(hn::BitCast(du, sum), hn::BitCast(du, hn::IfThenElse(still, zero, hn::BitCast(d, hn::Shl(hn::BitCast(du, unit), lead_u)))));
     // (A still pixel, whose w is 1 whatever c, reads node 0.)
-    const auto code = hn::BitCast(du, hn::IfThenZeroElse(still, hn::BitCast(d, hn::Shr(hn::ShiftLeftSame(below, p.reciprocal_input_bits), lead_u))));
-    const auto mantissa = interpolate(p.reciprocal, code);  // 1/m, uQ2.24 at the defaults
+    const auto code = hn::BitCast(du, hn::IfThenZeroElse(still, hn::BitCast(d, hn::Shr(hn::ShiftLeftSame(below, reciprocal_input_bits), lead_u))));
+    const auto mantissa = interpolate(reciprocal, code);  // 1/m, uQ2.24 at the defaults
     const auto product = hn::MulEven(hn::BitCast(du32, difference), hn::BitCast(du32, mantissa));
     const auto shift_u = hn::BitCast(du, hn::IfThenElse(still, unit, contrast_shift));
     const auto half = hn::Shr(hn::Shl(hn::BitCast(du, unit), shift_u), hn::BitCast(du, unit));
     const auto contrast = hn::Min(hn::BitCast(d, hn::Shr(hn::Add(product, half), shift_u)), one);  // uQ1.F
     // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
     const auto exponent = hn::ShiftRightSame(hn::Add(hn::MulEven(sensitivity, hn::BitCast(du32, contrast)), exponent_half),
-                                             p.exponent_shift);
-    const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, p.exp_input_frac_bits));
+                                             exponent_shift);
+    const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, exp_input_frac_bits));
     const auto underflow = hn::AndNot(still, hn::Gt(integer, fifteen));
-    const auto e_fraction = interpolate(p.exp_fraction, hn::And(exponent, fraction_mask));
+    const auto e_fraction = interpolate(exp_fraction, hn::And(exponent, fraction_mask));
     const auto e_integer = exp_of_integer(hn::Min(integer, fifteen));
     const auto w = hn::BitCast(d, hn::ShiftRightSame(hn::Add(hn::MulEven(hn::BitCast(du32, e_integer),
                                                                          hn::BitCast(du32, e_fraction)), linear_half),
-                                                     p.linear_frac_bits));
+                                                     linear_frac_bits));
     const auto result = hn::IfThenElse(still, one, hn::IfThenZeroElse(underflow, w));
     underflow_count += hn::CountTrue(d, underflow);
     weight_sum = hn::Add(weight_sum, result);
