@@ -862,50 +862,69 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   };
   auto weight_sum = zero;
   std::uint64_t underflow_count = 0;  // counted here, not through `tally` (a store per vector)
-  for (; x + lanes <= pixels; x += lanes) {
-    hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
-    hn::LoadInterleaved3(d, previous + 3 * x, pr, pg, pb);
-    hn::LoadInterleaved3(d, alpha + 3 * x, ar, ag, ab);
-    const auto out_of_lanes = hn::Or(hn::Or(hn::Or(outside(pr), outside(pg)), hn::Or(outside(pb), outside(ar))),
-                                     hn::Or(outside(ag), outside(ab)));
-    const auto yp = luma(pr, pg, pb);
-    const auto ya = luma(ar, ag, ab);
-    const auto sum = hn::Add(yp, ya);                                  // uQ2.F
-    const auto difference = hn::Sub(hn::Max(yp, ya), hn::Min(yp, ya));
-    const auto still = hn::Eq(difference, zero);                       // c = 0: w = 1
-    // The leading one of the sum from its double's exponent (the sum < 2^53 is exact), then Eq. 5 by the normalised
-    // reciprocal: m's fraction aligned to the ROM's input bits is (sum - 2^lead) 2^B >> lead.
-    const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, sum)))), exponent_bias);
-    const auto contrast_shift = hn::Add(lead, contrast_shift_offset);
-    if (!hn::AllFalse(d, hn::Or(out_of_lanes, hn::AndNot(still, hn::Lt(contrast_shift, unit))))) {
-      for (std::size_t i = 0; i < lanes; ++i) {
-        weight[x + i] = weight_scalar(previous + 3 * (x + i), alpha + 3 * (x + i), kernels, tally);
+  const auto still_mark = hn::Set(d, std::int64_t{-1});
+  // A chunk at a time in two passes, each with one ROM lookup in its chain: c (Eq. 5) into `weight`, -1 for a still
+  // pixel, then w (Eq. 6) from it. Vectors with a pixel outside the lanes take the stage functions in the first pass.
+  constexpr std::size_t kChunk = 256;
+  std::array<bool, kChunk> by_stage_functions{};
+  while (x + lanes <= pixels) {
+    const std::size_t count = std::min(kChunk, (pixels - x) / lanes * lanes);
+    for (std::size_t i = 0; i < count; i += lanes) {
+      const std::size_t at = x + i;
+      hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
+      hn::LoadInterleaved3(d, previous + 3 * at, pr, pg, pb);
+      hn::LoadInterleaved3(d, alpha + 3 * at, ar, ag, ab);
+      const auto out_of_lanes = hn::Or(hn::Or(hn::Or(outside(pr), outside(pg)), hn::Or(outside(pb), outside(ar))),
+                                       hn::Or(outside(ag), outside(ab)));
+      const auto yp = luma(pr, pg, pb);
+      const auto ya = luma(ar, ag, ab);
+      const auto sum = hn::Add(yp, ya);                                  // uQ2.F
+      const auto difference = hn::Sub(hn::Max(yp, ya), hn::Min(yp, ya));
+      const auto still = hn::Eq(difference, zero);                       // c = 0: w = 1
+      // The leading one of the sum from its double's exponent (the sum < 2^53 is exact), then Eq. 5 by the normalised
+      // reciprocal: m's fraction aligned to the ROM's input bits is (sum - 2^lead) 2^B >> lead.
+      const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, sum)))), exponent_bias);
+      const auto contrast_shift = hn::Add(lead, contrast_shift_offset);
+      by_stage_functions[i] = !hn::AllFalse(d, hn::Or(out_of_lanes, hn::AndNot(still, hn::Lt(contrast_shift, unit))));
+      if (by_stage_functions[i]) {
+        for (std::size_t k = 0; k < lanes; ++k) {
+          weight[at + k] = weight_scalar(previous + 3 * (at + k), alpha + 3 * (at + k), kernels, tally);
+        }
+        continue;
       }
-      continue;
+      const auto lead_u = hn::BitCast(du, hn::IfThenElse(still, zero, lead));
+      const auto below = hn::Sub(hn::BitCast(du, sum), hn::BitCast(du, hn::IfThenElse(still, zero, hn::BitCast(d, hn::Shl(hn::BitCast(du, unit), lead_u)))));
+      // (A still pixel, whose w is 1 whatever c, reads node 0.)
+      const auto code = hn::BitCast(du, hn::IfThenZeroElse(still, hn::BitCast(d, hn::Shr(hn::ShiftLeftSame(below, reciprocal_input_bits), lead_u))));
+      const auto mantissa = interpolate(reciprocal, code);  // 1/m, uQ2.24 at the defaults
+      const auto product = hn::MulEven(hn::BitCast(du32, difference), hn::BitCast(du32, mantissa));
+      const auto shift_u = hn::BitCast(du, hn::IfThenElse(still, unit, contrast_shift));
+      const auto half = hn::Shr(hn::Shl(hn::BitCast(du, unit), shift_u), hn::BitCast(du, unit));
+      const auto contrast = hn::Min(hn::BitCast(d, hn::Shr(hn::Add(product, half), shift_u)), one);  // uQ1.F
+      hn::StoreU(hn::IfThenElse(still, still_mark, contrast), d, weight + at);
     }
-    const auto lead_u = hn::BitCast(du, hn::IfThenElse(still, zero, lead));
-    const auto below = hn::Sub(hn::BitCast(du, sum), hn::BitCast(du, hn::IfThenElse(still, zero, hn::BitCast(d, hn::Shl(hn::BitCast(du, unit), lead_u)))));
-    // (A still pixel, whose w is 1 whatever c, reads node 0.)
-    const auto code = hn::BitCast(du, hn::IfThenZeroElse(still, hn::BitCast(d, hn::Shr(hn::ShiftLeftSame(below, reciprocal_input_bits), lead_u))));
-    const auto mantissa = interpolate(reciprocal, code);  // 1/m, uQ2.24 at the defaults
-    const auto product = hn::MulEven(hn::BitCast(du32, difference), hn::BitCast(du32, mantissa));
-    const auto shift_u = hn::BitCast(du, hn::IfThenElse(still, unit, contrast_shift));
-    const auto half = hn::Shr(hn::Shl(hn::BitCast(du, unit), shift_u), hn::BitCast(du, unit));
-    const auto contrast = hn::Min(hn::BitCast(d, hn::Shr(hn::Add(product, half), shift_u)), one);  // uQ1.F
-    // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
-    const auto exponent = hn::ShiftRightSame(hn::Add(hn::MulEven(sensitivity, hn::BitCast(du32, contrast)), exponent_half),
-                                             exponent_shift);
-    const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, exp_input_frac_bits));
-    const auto underflow = hn::AndNot(still, hn::Gt(integer, fifteen));
-    const auto e_fraction = interpolate(exp_fraction, hn::And(exponent, fraction_mask));
-    const auto e_integer = exp_of_integer(hn::Min(integer, fifteen));
-    const auto w = hn::BitCast(d, hn::ShiftRightSame(hn::Add(hn::MulEven(hn::BitCast(du32, e_integer),
-                                                                         hn::BitCast(du32, e_fraction)), linear_half),
-                                                     linear_frac_bits));
-    const auto result = hn::IfThenElse(still, one, hn::IfThenZeroElse(underflow, w));
-    underflow_count += hn::CountTrue(d, underflow);
-    weight_sum = hn::Add(weight_sum, result);
-    hn::StoreU(result, d, weight + x);
+    for (std::size_t i = 0; i < count; i += lanes) {
+      if (by_stage_functions[i]) continue;
+      const std::size_t at = x + i;
+      const auto stored = hn::LoadU(d, weight + at);
+      const auto still = hn::Lt(stored, zero);
+      // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
+      const auto contrast = hn::IfThenZeroElse(still, stored);
+      const auto exponent = hn::ShiftRightSame(hn::Add(hn::MulEven(sensitivity, hn::BitCast(du32, contrast)), exponent_half),
+                                               exponent_shift);
+      const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, exp_input_frac_bits));
+      const auto underflow = hn::AndNot(still, hn::Gt(integer, fifteen));
+      const auto e_fraction = interpolate(exp_fraction, hn::And(exponent, fraction_mask));
+      const auto e_integer = exp_of_integer(hn::Min(integer, fifteen));
+      const auto w = hn::BitCast(d, hn::ShiftRightSame(hn::Add(hn::MulEven(hn::BitCast(du32, e_integer),
+                                                                           hn::BitCast(du32, e_fraction)), linear_half),
+                                                       linear_frac_bits));
+      const auto result = hn::IfThenElse(still, one, hn::IfThenZeroElse(underflow, w));
+      underflow_count += hn::CountTrue(d, underflow);
+      weight_sum = hn::Add(weight_sum, result);
+      hn::StoreU(result, d, weight + at);
+    }
+    x += count;
   }
   tally.weight_sum += hn::GetLane(hn::SumOfLanes(d, weight_sum));
   tally.underflow += underflow_count;
