@@ -261,35 +261,73 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   const auto offset_mask = hn::Set(du, packed ? (std::uint32_t{1} << p.offset_bits) - 1 : 0u);
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
-  for (; s + lanes <= n; s += lanes, phase = next_phase(phase, phase_step)) {
-    const auto low = hn::LoadU(d64, linear + s);
-    const auto high = hn::LoadU(d64, linear + s + half);
+  // x in 32-bit lanes, its octave and its top bits; false where a lane is outside the index (the generic search).
+  struct Place {
+    hn::Vec<decltype(d)> x, octave, top_bits;
+  };
+  const auto place_of = [&](std::size_t at, Place& place) {
+    const auto low = hn::LoadU(d64, linear + at);
+    const auto high = hn::LoadU(d64, linear + at + half);
     const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero64), hn::Not(hn::Lt(v, limit64))); };
-    if (!hn::AllFalse(d64, hn::Or(outside(low), outside(high)))) {  // outside the index: generic search
-      for (std::size_t i = 0; i < lanes; ++i) out[s + i] = drive_scalar(linear[s + i], s + i, p);
-      continue;
-    }
+    if (!hn::AllFalse(d64, hn::Or(outside(low), outside(high)))) return false;
     const auto x = hn::BitCast(d, hn::Combine(du, hn::TruncateTo(duh, hn::BitCast(du64, high)),
                                               hn::TruncateTo(duh, hn::BitCast(du64, low))));
     const auto large = hn::Not(hn::Lt(x, exact_float));
     const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<6>(x), x)));
     const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, six));
-    const auto top_bits = hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 23 - m), mantissa_mask));
-    const auto octave = hn::Sub(exponent, exponent_bias);
-    if (packed) {
-      // One gather (DrivePlan::packed32): x's bits below its bucket's lower end against the next threshold's offset.
-      const auto small = hn::Lt(x, direct);
-      const auto bucket = hn::IfThenElse(small, x, hn::Add(hn::ShiftLeftSame(octave, m), top_bits));
-      const auto word = hn::BitCast(du, hn::GatherIndex(d, packed_words, hn::Add(bucket, hn::LoadU(d, p.bucket_offset32.data() + phase))));
-      const auto below_bits = hn::Sub(hn::Shl(one32, hn::BitCast(du, hn::Max(hn::Sub(octave, hn::BitCast(d, one32)), hn::Zero(d)))), one32);
-      const auto low = hn::IfThenZeroElse(hn::RebindMask(du, small), hn::And(hn::BitCast(du, x), below_bits));
-      const auto k = hn::ShiftRightSame(word, p.offset_bits);
-      const auto code = hn::Add(k, hn::IfThenZeroElse(hn::Lt(low, hn::And(word, offset_mask)), one32));
-      hn::StoreU(hn::DemoteTo(d16, hn::BitCast(d, code)), d16, out + s);
+    place = Place{x, hn::Sub(exponent, exponent_bias), hn::BitCast(d, hn::And(hn::ShiftRightSame(bits, 23 - m), mantissa_mask))};
+    return true;
+  };
+  const auto generic = [&](std::size_t at) {
+    for (std::size_t i = 0; i < lanes; ++i) out[at + i] = drive_scalar(linear[at + i], at + i, p);
+  };
+  if (packed) {
+    // One lookup per sample (DrivePlan::packed32): x's bits below its bucket's lower end against the next threshold's
+    // offset. A chunk at a time in passes: the words' places and those bits, the words by scalar loads (a gather in
+    // the vector chain stalls it), the codes.
+    constexpr std::size_t kChunk = 256;
+    HWY_ALIGN std::uint32_t words[kChunk];
+    HWY_ALIGN std::uint32_t below[kChunk];
+    std::array<bool, kChunk> by_generic_search{};
+    const std::int32_t* bucket_offset = p.bucket_offset32.data();  // locals: a vector store may alias the plan
+    const int offset_bits = p.offset_bits;
+    while (s + lanes <= n) {
+      const std::size_t count = std::min(kChunk, (n - s) / lanes * lanes);
+      for (std::size_t i = 0; i < count; i += lanes, phase = next_phase(phase, phase_step)) {
+        Place place;
+        by_generic_search[i] = !place_of(s + i, place);
+        if (by_generic_search[i]) {
+          generic(s + i);
+          hn::Store(hn::Zero(du), du, words + i);
+          continue;
+        }
+        const auto small = hn::Lt(place.x, direct);
+        const auto bucket = hn::IfThenElse(small, place.x, hn::Add(hn::ShiftLeftSame(place.octave, m), place.top_bits));
+        hn::Store(hn::BitCast(du, hn::Add(bucket, hn::LoadU(d, bucket_offset + phase))), du, words + i);
+        const auto below_bits = hn::Sub(hn::Shl(one32, hn::BitCast(du, hn::Max(hn::Sub(place.octave, hn::BitCast(d, one32)), hn::Zero(d)))), one32);
+        hn::Store(hn::IfThenZeroElse(hn::RebindMask(du, small), hn::And(hn::BitCast(du, place.x), below_bits)), du, below + i);
+      }
+      const auto* packed_table = reinterpret_cast<const std::uint32_t*>(packed_words);
+      for (std::size_t i = 0; i < count; ++i) words[i] = packed_table[words[i]];
+      for (std::size_t i = 0; i < count; i += lanes) {
+        if (by_generic_search[i]) continue;
+        const auto word = hn::Load(du, words + i);
+        const auto k = hn::ShiftRightSame(word, offset_bits);
+        const auto code = hn::Add(k, hn::IfThenZeroElse(hn::Lt(hn::Load(du, below + i), hn::And(word, offset_mask)), one32));
+        hn::StoreU(hn::DemoteTo(d16, hn::BitCast(d, code)), d16, out + s + i);
+      }
+      s += count;
+    }
+    return s;
+  }
+  for (; s + lanes <= n; s += lanes, phase = next_phase(phase, phase_step)) {
+    Place place;
+    if (!place_of(s, place)) {
+      generic(s);
       continue;
     }
-    const auto k = IndexSearch(d, x, octave, top_bits, m, p.steps, p.base32.data(), p.bucket_offset32.data() + phase,
-                               p.thresholds32.data());
+    const auto k = IndexSearch(d, place.x, place.octave, place.top_bits, m, p.steps, p.base32.data(),
+                               p.bucket_offset32.data() + phase, p.thresholds32.data());
     const auto code = hn::Sub(k, hn::LoadU(d, p.threshold_offset32.data() + phase));
     hn::StoreU(hn::DemoteTo(d16, code), d16, out + s);
   }
