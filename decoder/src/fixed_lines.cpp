@@ -384,9 +384,6 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
-  const hn::Rebind<std::uint16_t, decltype(d)> d16;
-  const hn::Rebind<std::uint32_t, decltype(d)> d32;
-  const hn::RebindToUnsigned<decltype(d)> du;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, one_value);
@@ -397,21 +394,15 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
     hn::StoreU(clamped, d, shown + at);
     hn::StoreU(hn::Sub(beta, clamped), d, rho + at);
   };
-  if (!plans.code_rom32.empty()) {
-    // lin(E) of two vectors' samples by one gather of 32-bit words.
-    const hn::Repartition<std::int32_t, decltype(d)> di32;
-    const hn::Rebind<std::uint16_t, decltype(di32)> d16w;
-    const hn::Half<decltype(di32)> di32h;
-    for (; s + 2 * lanes <= n; s += 2 * lanes) {
-      const auto code = hn::BitCast(di32, hn::PromoteTo(hn::RebindToUnsigned<decltype(di32)>(), hn::LoadU(d16w, codes + s)));
-      const auto full = hn::GatherIndex(di32, plans.code_rom32.data(), code);
-      split(hn::PromoteTo(d, hn::LowerHalf(di32h, full)), s);
-      split(hn::PromoteTo(d, hn::UpperHalf(di32h, full)), s + lanes);
-    }
-  }
-  for (; s + lanes <= n; s += lanes) {
-    const auto code = hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(d32, hn::LoadU(d16, codes + s))));
-    split(hn::GatherIndex(d, code_rom, code), s);
+  // lin(E) a chunk of samples at a time by scalar loads (the ROM is small; a gather costs more than the loads and
+  // stalls the vector chain), then the split.
+  constexpr std::size_t kChunk = 256;
+  HWY_ALIGN std::int64_t full[kChunk];
+  while (s + lanes <= n) {
+    const std::size_t count = std::min(kChunk, (n - s) / lanes * lanes);
+    for (std::size_t i = 0; i < count; ++i) full[i] = code_rom[codes[s + i]];
+    for (std::size_t i = 0; i < count; i += lanes) split(hn::Load(d, full + i), s + i);
+    s += count;
   }
 #endif
   for (; s < n; ++s) {
@@ -1155,9 +1146,6 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   FixedLinePlans plans;
   if (!c.line_kernels) return plans;
   plans.code_rom = kernels.code_rom();
-  if (std::ranges::all_of(plans.code_rom, [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; })) {
-    plans.code_rom32.assign(plans.code_rom.begin(), plans.code_rom.end());
-  }
   plans.one = kernels.one();
   const int F = c.linear_frac_bits;
   const int W = c.bilinear_weight_frac_bits;

@@ -202,7 +202,6 @@ struct FixedLinePlans {
   std::optional<GaussianPlan> gaussian;  // encoded space, max_code 2^T and max_code 2^L below 2^32
   std::optional<LcdPlan> lcd;            // LCD with the merge table (output codes up to 8 bits), F <= 30
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
-  std::vector<std::int32_t> code_rom32;  // the same where every word fits 32 bits (twice the lanes per gather)
   std::int64_t one = 0;
 
   static FixedLinePlans build(const FixedKernels& kernels);

@@ -661,7 +661,6 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   EXPECT_TRUE(plans_of(oled).drive.has_value());
   EXPECT_TRUE(plans_of(oled).motion.has_value());
   EXPECT_TRUE(plans_of(oled).gaussian.has_value());
-  EXPECT_FALSE(plans_of(oled).code_rom32.empty()) << "lin(E) gathered as 32-bit words";
   EXPECT_FALSE(plans_of(oled).drive->packed32.empty()) << "the OLED drive search in one gather at 8 bits";
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).gaussian.has_value());
   FixedDecoderConfig still = oled;
