@@ -197,14 +197,25 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   const auto upper_weight = hn::BitCast(du32, hn::Set(du, upper));
   const auto blend_half = hn::Set(du, std::uint64_t{1} << (blend_shift - 1));
   const auto weight_mask = hn::Set(du, (std::uint64_t{1} << weight_bits) - 1);
-  for (; s + lanes <= n; s += lanes) {
-    const auto t = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, top + s)));
-    const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s)));
-    const auto blended = hn::Add(hn::MulEven(lower_weight, t), hn::MulEven(upper_weight, b));  // uQb.2W
-    const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), blend_shift);       // uQb.U
-    const auto node = hn::BitCast(d, hn::ShiftRightSame(upsampled, weight_bits));
-    const auto weight = hn::BitCast(d, hn::And(upsampled, weight_mask));
-    hn::StoreU(InterpolateWord(d, LookupWords(d, packed, node), weight, weight_bits), d, out + s);
+  // A chunk at a time in passes: the blend into `out`, the ROM words by scalar loads, the interpolation.
+  constexpr std::size_t kChunk = 256;
+  HWY_ALIGN std::int64_t words[kChunk];
+  while (s + lanes <= n) {
+    const std::size_t count = std::min(kChunk, (n - s) / lanes * lanes);
+    for (std::size_t i = 0; i < count; i += lanes) {
+      const auto t = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, top + s + i)));
+      const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s + i)));
+      const auto blended = hn::Add(hn::MulEven(lower_weight, t), hn::MulEven(upper_weight, b));  // uQb.2W
+      const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), blend_shift);       // uQb.U
+      hn::StoreU(hn::BitCast(d, upsampled), d, out + s + i);
+      hn::Store(hn::BitCast(d, hn::ShiftRightSame(upsampled, weight_bits)), d, words + i);
+    }
+    for (std::size_t i = 0; i < count; ++i) words[i] = packed[words[i]];
+    for (std::size_t i = 0; i < count; i += lanes) {
+      const auto weight = hn::BitCast(d, hn::And(hn::BitCast(du, hn::LoadU(d, out + s + i)), weight_mask));
+      hn::StoreU(InterpolateWord(d, hn::Load(d, words + i), weight, weight_bits), d, out + s + i);
+    }
+    s += count;
   }
 #endif
   for (; s < n; ++s) {
