@@ -45,6 +45,17 @@ HWY_INLINE hn::Vec<D> LookupWords(D d, const std::int64_t* table, hn::Vec<D> ind
   }
 }
 
+// A count of true mask lanes kept per lane (one subtraction of the all-ones lanes per mask, where moving the mask to a
+// scalar and counting its bits is a longer chain), and its total.
+template <class D>
+HWY_INLINE hn::Vec<D> CountInto(D d, hn::Vec<D> counts, hn::Mask<D> mask) {
+  return hn::Sub(counts, hn::VecFromMask(d, mask));
+}
+template <class D>
+HWY_INLINE std::uint64_t Total(D d, hn::Vec<D> counts) {
+  return static_cast<std::uint64_t>(hn::GetLane(hn::SumOfLanes(d, counts)));
+}
+
 // A ROM word's interpolation, rounded half up: (node 2^j + step w + 2^(j-1)) >> j of word = node << 32 | step
 // (packed_rom) and weight w in [0, 2^j). In unsigned lanes, exact because packed_rom takes only ROMs whose every node
 // and node + step are non-negative, so the sum (a weighted mean of the two times 2^j) is; AVX2 has no 64-bit
@@ -398,10 +409,11 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, one_value);
+  auto clipped_lanes = zero;
   const auto split = [&](const auto full, std::size_t at) {
     const auto beta = hn::Sub(hn::Add(full, full), hn::LoadU(d, low + at));
     const auto clamped = hn::Min(hn::Max(beta, zero), one);
-    clipped += hn::CountTrue(d, hn::Not(hn::Eq(clamped, beta)));
+    clipped_lanes = CountInto(d, clipped_lanes, hn::Not(hn::Eq(clamped, beta)));
     hn::StoreU(clamped, d, shown + at);
     hn::StoreU(hn::Sub(beta, clamped), d, rho + at);
   };
@@ -415,6 +427,7 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
     for (std::size_t i = 0; i < count; i += lanes) split(hn::Load(d, full + i), s + i);
     s += count;
   }
+  clipped += Total(d, clipped_lanes);
 #endif
   for (; s < n; ++s) {
     const std::int64_t beta = 2 * code_rom[codes[s]] - low[s];
@@ -709,6 +722,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto top = hn::Set(d, std::int64_t{p.top});
   const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
   const auto exponent_bias = hn::Set(d, std::int64_t{1023});
+  auto unreachable_lanes = zero;
   const auto held_row = hn::Set(d, p.width);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
   // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
   const int target_shift = p.target_shift;
@@ -752,7 +766,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto drive = hn::IfThenElse(clamped, hn::IfThenElseZero(above, top), lo);
     const auto end = hn::IfThenElse(above, end_bright, end_dark);
     const auto contributed = hn::IfThenElse(clamped, hn::Sub(hn::Add(end, end), x_previous), x);
-    unreachable += hn::CountTrue(d, clamped);
+    unreachable_lanes = CountInto(d, unreachable_lanes, clamped);
     if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + i);
     const auto stored = contributed_stored ? contributed : x;
     hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + i);
@@ -811,6 +825,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
       s += m;
     }
   }
+  unreachable += Total(d, unreachable_lanes);
 #endif
   for (; s < n; ++s) {
     codes[s] = lcd_scalar(wanted[s], p, kernels, previous_code[s], previous_linear[s], held,
@@ -901,7 +916,7 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     return hn::IfThenElse(hn::Gt(i, lane_mask), hn::TableLookupLanes(rom_high, lane), hn::TableLookupLanes(rom_low, lane));
   };
   auto weight_sum = zero;
-  std::uint64_t underflow_count = 0;  // counted here, not through `tally` (a store per vector)
+  auto underflow_lanes = zero;  // counted here, not through `tally` (a store per vector)
   const auto still_mark = hn::Set(d, std::int64_t{-1});
   // A chunk at a time in two passes, each with one ROM lookup in its chain: c (Eq. 5) into `weight`, -1 for a still
   // pixel, then w (Eq. 6) from it. Vectors with a pixel outside the lanes take the stage functions in the first pass.
@@ -960,14 +975,14 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
                                                                            hn::BitCast(du32, e_fraction)), linear_half),
                                                        linear_frac_bits));
       const auto result = hn::IfThenElse(still, one, hn::IfThenZeroElse(underflow, w));
-      underflow_count += hn::CountTrue(d, underflow);
+      underflow_lanes = CountInto(d, underflow_lanes, underflow);
       weight_sum = hn::Add(weight_sum, result);
       hn::StoreU(result, d, weight + at);
     }
     x += count;
   }
   tally.weight_sum += hn::GetLane(hn::SumOfLanes(d, weight_sum));
-  tally.underflow += underflow_count;
+  tally.underflow += Total(d, underflow_lanes);
 #endif
   for (; x < pixels; ++x) weight[x] = weight_scalar(previous + 3 * x, alpha + 3 * x, kernels, tally);
 }
@@ -983,17 +998,20 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, p.one);
-  const auto residual_half = hn::Set(d, std::int64_t{1} << (p.residual_frac_bits - 1));
+  const int residual_frac_bits = p.residual_frac_bits;  // a local: the compiler reloads what a store could alias
+  const auto residual_half = hn::Set(d, std::int64_t{1} << (residual_frac_bits - 1));
   // Element e: e / 3, so that the pixels of the samples s0.. of a vector are s0 / 3 plus the elements (s0 mod 3)..
   static const std::array<std::int64_t, 3 + DrivePlan::kMaxLanes> third = [] {
     std::array<std::int64_t, 3 + DrivePlan::kMaxLanes> t{};
     for (std::size_t e = 0; e < t.size(); ++e) t[e] = static_cast<std::int64_t>(e / 3);
     return t;
   }();
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Rebind<std::uint32_t, decltype(d)> du32h;
   auto dropped = zero;
-  std::uint64_t clipped_count = 0;
+  auto clipped_lanes = zero;
   auto magnitude_sum = zero;
-  auto magnitude_max = zero;
+  auto magnitude_max = hn::Zero(du32h);
   std::size_t phase = 0;
   const std::size_t phase_step = lanes % 3;
   // Sample s + i of a vector reads pixel s / 3 + third[phase + i] (phase = s mod 3), all within the vector's first
@@ -1011,22 +1029,27 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
       }
       continue;
     }
-    const auto rho = hn::PromoteTo(d, hn::LoadU(d32, residual + s));
+    const auto rho32 = hn::LoadU(d32, residual + s);
+    const auto rho = hn::PromoteTo(d, rho32);
     // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho (uQ1.F x sQ.R) rounded to F fraction bits.
     const auto product = hn::MulEven(hn::BitCast(di32, w), hn::BitCast(di32, rho));
-    const auto sum = hn::Add(hn::LoadU(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), p.residual_frac_bits));
-    const auto clamped = hn::Min(hn::Max(sum, zero), one);
-    clipped_count += hn::CountTrue(d, hn::Not(hn::Eq(clamped, sum)));
-    dropped = hn::Add(dropped, hn::Sub(hn::Max(sum, clamped), hn::Min(sum, clamped)));
-    const auto magnitude = hn::Max(rho, hn::Neg(rho));
-    magnitude_sum = hn::Add(magnitude_sum, magnitude);
+    const auto sum = hn::Add(hn::LoadU(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), residual_frac_bits));
+    // The clamp and what it drops (|sum - clamped|) from two comparisons: AVX2 has no 64-bit minimum or maximum.
+    const auto negative = hn::Lt(sum, zero);
+    const auto above = hn::Gt(sum, one);
+    hn::StoreU(hn::IfThenZeroElse(negative, hn::IfThenElse(above, one, sum)), d, shown + s);
+    clipped_lanes = CountInto(d, clipped_lanes, hn::Or(negative, above));
+    dropped = hn::Add(dropped, hn::IfThenElse(negative, hn::Neg(sum), hn::IfThenElseZero(above, hn::Sub(sum, one))));
+    // |rho| in 32-bit lanes, read unsigned (|INT32_MIN| = 2^31 too).
+    const auto magnitude = hn::BitCast(du32h, hn::Abs(rho32));
+    magnitude_sum = hn::Add(magnitude_sum, hn::BitCast(d, hn::PromoteTo(du, magnitude)));
     magnitude_max = hn::Max(magnitude_max, magnitude);
-    hn::StoreU(clamped, d, shown + s);
   }
-  tally.clipped += clipped_count;
+  tally.clipped += Total(d, clipped_lanes);
   tally.dropped_sum += hn::GetLane(hn::SumOfLanes(d, dropped));
   tally.residual_abs_sum += hn::GetLane(hn::SumOfLanes(d, magnitude_sum));
-  tally.residual_abs_max = std::max(tally.residual_abs_max, hn::GetLane(hn::MaxOfLanes(d, magnitude_max)));
+  tally.residual_abs_max =
+      std::max(tally.residual_abs_max, static_cast<std::int64_t>(hn::GetLane(hn::MaxOfLanes(du32h, magnitude_max))));
 #endif
   for (; s < n; ++s) shown[s] = weighted_scalar(alpha[s], weight[s / 3], residual[s], kernels, tally);
 }
