@@ -77,7 +77,8 @@ HWY_INLINE hn::Vec<D> InterpolateWord(D d, hn::Vec<D> word, hn::Vec<D> weight, S
   }
 }
 
-// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1] (the table carries one word more).
+// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1]: on four lanes (AVX2) four 128-bit loads of the
+// pairs, else two gathers.
 template <class D>
 HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn::Vec<D>& first, hn::Vec<D>& second) {
   const auto at = hn::Add(index, index);
@@ -739,9 +740,13 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const auto previous_row = [&](std::size_t i) {
     return hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d8, previous_code + i))));
   };
-  // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one.
-  // (A sum of 2 or more reads 1, not the ROM: its code is clamped as evaluate_raw clamps it.)
-  const auto target_of = [&](const auto sum) {
+  // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one, the node and the
+  // weight, then the node's word interpolated. (A sum of 2 or more reads 1, not the ROM: its code is clamped as
+  // evaluate_raw clamps it.)
+  struct RomPlace {
+    hn::Vec<decltype(d)> node, weight, scale_bits;
+  };
+  const auto target_place = [&](const auto sum) {
     const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), target_shift), top_code);
     const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
     const auto bottom = hn::Lt(lead, bottom_bits);
@@ -749,10 +754,16 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
     const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
     const auto scaled = hn::ShiftLeftSame(offset, segments_log2);
-    const auto node = hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits));
-    const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
-    const auto rom_target = InterpolateWord(d, LookupWords(d, target_packed, node), weight, scale_bits);
+    return RomPlace{hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits)),
+                    hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit)), scale_bits};
+  };
+  const auto target_from = [&](const auto sum, const auto word, const auto weight, const auto scale_bits) {
+    const auto rom_target = InterpolateWord(d, word, weight, scale_bits);
     return hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
+  };
+  const auto target_of = [&](const auto sum) {
+    const RomPlace place = target_place(sum);
+    return target_from(sum, LookupWords(d, target_packed, place.node), place.weight, place.scale_bits);
   };
   // Given v_{t-1} = j and lo, the largest k with M(T_k, v_{t-1}) <= m: the unreachable ends, the codes and the
   // frame stores.
@@ -786,22 +797,33 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
       finish(s, x, x_previous, sum, j, search(j));
     }
   } else {
-    // Through the index, a chunk of samples at a time in passes: m and the words' places, then the words by scalar
-    // loads, then the codes. The index is larger than a core's L2 cache and a vector's lookups would stall its
+    // Through the index, a chunk of samples at a time in passes: m's ROM places, its ROM words by scalar loads, m and
+    // the index words' places, those words by scalar loads, then the codes. A vector's own lookups would stall its
     // chain; loads independent of each other overlap.
     constexpr std::size_t kChunk = 256;
     HWY_ALIGN std::int64_t targets[kChunk];
     HWY_ALIGN std::int64_t words[kChunk];
     HWY_ALIGN std::int64_t held_codes[kChunk];
+    HWY_ALIGN std::int64_t rom_weights[kChunk];
+    HWY_ALIGN std::int64_t rom_shifts[kChunk];
     const std::uint32_t* index = p.index.data();
     const auto look_up = [&](std::size_t m) {
       for (std::size_t i = 0; i < m; ++i) words[i] = index[words[i]];
     };
     while (s + lanes <= n) {
       const std::size_t m = std::min(kChunk, (n - s) / lanes * lanes);
+      for (std::size_t i = 0; i < m; i += lanes) {  // m's ROM places, then its words
+        const auto x = hn::LoadU(d, wanted + s + i);
+        const RomPlace place = target_place(hn::Add(x, previous_of(s + i, x)));
+        hn::Store(place.node, d, targets + i);
+        hn::Store(place.weight, d, rom_weights + i);
+        hn::Store(place.scale_bits, d, rom_shifts + i);
+      }
+      for (std::size_t i = 0; i < m; ++i) targets[i] = target_packed[targets[i]];
       for (std::size_t i = 0; i < m; i += lanes) {
         const auto x = hn::LoadU(d, wanted + s + i);
-        const auto target = target_of(hn::Add(x, previous_of(s + i, x)));
+        const auto target = target_from(hn::Add(x, previous_of(s + i, x)), hn::Load(d, targets + i),
+                                        hn::Load(d, rom_weights + i), hn::Load(d, rom_shifts + i));
         hn::Store(target, d, targets + i);
         hn::Store(LcdIndexAt(d, shape, target, held ? held_row : previous_row(s + i)), d, words + i);
       }
@@ -855,6 +877,8 @@ inline std::int64_t weighted_scalar(std::int64_t alpha, std::int64_t weight, std
   return s.alpha_prime;
 }
 
+constexpr std::size_t kMotionChunk = 256;  // pixels per pass of MotionWeights
+
 void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
   std::size_t x = 0;
@@ -892,11 +916,15 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   };
   const Rom reciprocal{p.reciprocal.packed.data(), p.reciprocal.weight_bits};
   const Rom exp_fraction{p.exp_fraction.packed.data(), p.exp_fraction.weight_bits};
-  const auto interpolate = [&](const Rom& rom, const auto code) {
+  // A ROM's node of code into words[i], and (after the lookup pass) its interpolation from words[i].
+  HWY_ALIGN std::int64_t words[kMotionChunk];
+  const auto place_in = [&](const Rom& rom, const auto code, std::size_t i) {
+    hn::Store(hn::BitCast(d, hn::ShiftRightSame(code, rom.weight_bits)), d, words + i);
+  };
+  const auto interpolated = [&](const Rom& rom, const auto code, std::size_t i) {
     const int j = rom.weight_bits;
-    const auto node = hn::BitCast(d, hn::ShiftRightSame(code, j));
     const auto low = hn::BitCast(d, hn::And(code, hn::Set(du, (std::uint64_t{1} << j) - 1)));
-    return InterpolateWord(d, LookupWords(d, rom.packed, node), low, j);
+    return InterpolateWord(d, hn::Load(d, words + i), low, j);
   };
   const auto luma = [&](const auto r, const auto g, const auto b) {
     const auto sum = hn::Add(hn::Add(hn::MulEven(luma_weight_r, hn::BitCast(du32, r)),
@@ -905,25 +933,19 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     return hn::BitCast(d, hn::ShiftRightSame(hn::Add(sum, luma_half), luma_shift));  // uQ1.F
   };
   const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero), hn::Gt(v, one)); };
-  // exp(-i) of i in [0, 15]: where a vector holds 8 words (AVX-512), the 16-word ROM is two vectors, read by lane
-  // permutations (no gather); else gathered.
-  const auto rom_low = hn::LoadU(d, p.exp_integer.data());
-  const auto rom_high = lanes == 8 ? hn::LoadU(d, p.exp_integer.data() + lanes) : zero;
-  const auto lane_mask = hn::Set(d, static_cast<std::int64_t>(lanes) - 1);
-  const auto exp_of_integer = [&](const auto i) {
-    if (lanes != 8) return hn::GatherIndex(d, p.exp_integer.data(), i);
-    const auto lane = hn::IndicesFromVec(d, hn::And(i, lane_mask));
-    return hn::IfThenElse(hn::Gt(i, lane_mask), hn::TableLookupLanes(rom_high, lane), hn::TableLookupLanes(rom_low, lane));
-  };
   auto weight_sum = zero;
   auto underflow_lanes = zero;  // counted here, not through `tally` (a store per vector)
-  const auto still_mark = hn::Set(d, std::int64_t{-1});
-  // A chunk at a time in two passes, each with one ROM lookup in its chain: c (Eq. 5) into `weight`, -1 for a still
-  // pixel, then w (Eq. 6) from it. Vectors with a pixel outside the lanes take the stage functions in the first pass.
-  constexpr std::size_t kChunk = 256;
-  std::array<bool, kChunk> by_stage_functions{};
+  // A chunk at a time in passes, so that no ROM lookup sits inside a long vector chain: Eq. 5 up to the reciprocal
+  // ROM's places; its words by scalar loads; c and Eq. 6's places (the exp ROM and exp(-i)); their words; w. Vectors
+  // with a pixel outside the lanes take the stage functions in the first pass.
+  std::array<bool, kMotionChunk> by_stage_functions{};
+  HWY_ALIGN std::int64_t codes[kMotionChunk];  // the reciprocal ROM's input, then x = s c
+  HWY_ALIGN std::int64_t differences[kMotionChunk];  // |Yp - Ya|, 0 for a still pixel
+  HWY_ALIGN std::int64_t shifts[kMotionChunk];  // c's rounding shift
+  HWY_ALIGN std::int64_t integers[kMotionChunk];  // i, then exp(-i)
+  const std::int64_t* exp_integer = p.exp_integer.data();
   while (x + lanes <= pixels) {
-    const std::size_t count = std::min(kChunk, (pixels - x) / lanes * lanes);
+    const std::size_t count = std::min(kMotionChunk, (pixels - x) / lanes * lanes);
     for (std::size_t i = 0; i < count; i += lanes) {
       const std::size_t at = x + i;
       hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
@@ -945,32 +967,50 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
         for (std::size_t k = 0; k < lanes; ++k) {
           weight[at + k] = weight_scalar(previous + 3 * (at + k), alpha + 3 * (at + k), kernels, tally);
         }
+        hn::Store(zero, d, words + i);  // a place the lookup pass may read
         continue;
       }
       const auto lead_u = hn::BitCast(du, hn::IfThenElse(still, zero, lead));
       const auto below = hn::Sub(hn::BitCast(du, sum), hn::BitCast(du, hn::IfThenElse(still, zero, hn::BitCast(d, hn::Shl(hn::BitCast(du, unit), lead_u)))));
       // (A still pixel, whose w is 1 whatever c, reads node 0.)
       const auto code = hn::BitCast(du, hn::IfThenZeroElse(still, hn::BitCast(d, hn::Shr(hn::ShiftLeftSame(below, reciprocal_input_bits), lead_u))));
-      const auto mantissa = interpolate(reciprocal, code);  // 1/m, uQ2.24 at the defaults
-      const auto product = hn::MulEven(hn::BitCast(du32, difference), hn::BitCast(du32, mantissa));
-      const auto shift_u = hn::BitCast(du, hn::IfThenElse(still, unit, contrast_shift));
+      place_in(reciprocal, code, i);
+      hn::Store(hn::BitCast(d, code), d, codes + i);
+      hn::Store(difference, d, differences + i);
+      hn::Store(hn::IfThenElse(still, unit, contrast_shift), d, shifts + i);
+    }
+    for (std::size_t i = 0; i < count; ++i) words[i] = reciprocal.packed[words[i]];
+    for (std::size_t i = 0; i < count; i += lanes) {
+      if (by_stage_functions[i]) {
+        hn::Store(zero, d, words + i);
+        hn::Store(zero, d, integers + i);
+        continue;
+      }
+      const auto mantissa = interpolated(reciprocal, hn::BitCast(du, hn::Load(d, codes + i)), i);  // 1/m, uQ2.24 at the defaults
+      const auto product = hn::MulEven(hn::BitCast(du32, hn::Load(d, differences + i)), hn::BitCast(du32, mantissa));
+      const auto shift_u = hn::BitCast(du, hn::Load(d, shifts + i));
       const auto half = hn::Shr(hn::Shl(hn::BitCast(du, unit), shift_u), hn::BitCast(du, unit));
       const auto contrast = hn::Min(hn::BitCast(d, hn::Shr(hn::Add(product, half), shift_u)), one);  // uQ1.F
-      hn::StoreU(hn::IfThenElse(still, still_mark, contrast), d, weight + at);
+      // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
+      const auto exponent = hn::ShiftRightSame(hn::Add(hn::MulEven(sensitivity, hn::BitCast(du32, contrast)), exponent_half),
+                                               exponent_shift);
+      hn::Store(hn::BitCast(d, exponent), d, codes + i);
+      place_in(exp_fraction, hn::And(exponent, fraction_mask), i);
+      hn::Store(hn::Min(hn::BitCast(d, hn::ShiftRightSame(exponent, exp_input_frac_bits)), fifteen), d, integers + i);
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      words[i] = exp_fraction.packed[words[i]];
+      integers[i] = exp_integer[integers[i]];
     }
     for (std::size_t i = 0; i < count; i += lanes) {
       if (by_stage_functions[i]) continue;
       const std::size_t at = x + i;
-      const auto stored = hn::LoadU(d, weight + at);
-      const auto still = hn::Lt(stored, zero);
-      // Eq. 6: x = s c in uQ5.X, w = exp(-i) exp(-f).
-      const auto contrast = hn::IfThenZeroElse(still, stored);
-      const auto exponent = hn::ShiftRightSame(hn::Add(hn::MulEven(sensitivity, hn::BitCast(du32, contrast)), exponent_half),
-                                               exponent_shift);
+      const auto still = hn::Eq(hn::Load(d, differences + i), zero);
+      const auto exponent = hn::BitCast(du, hn::Load(d, codes + i));
       const auto integer = hn::BitCast(d, hn::ShiftRightSame(exponent, exp_input_frac_bits));
       const auto underflow = hn::AndNot(still, hn::Gt(integer, fifteen));
-      const auto e_fraction = interpolate(exp_fraction, hn::And(exponent, fraction_mask));
-      const auto e_integer = exp_of_integer(hn::Min(integer, fifteen));
+      const auto e_fraction = interpolated(exp_fraction, hn::And(exponent, fraction_mask), i);
+      const auto e_integer = hn::Load(d, integers + i);
       const auto w = hn::BitCast(d, hn::ShiftRightSame(hn::Add(hn::MulEven(hn::BitCast(du32, e_integer),
                                                                            hn::BitCast(du32, e_fraction)), linear_half),
                                                        linear_frac_bits));
@@ -1246,7 +1286,6 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
       l.ends.push_back(end_dark[v]);
       l.ends.push_back(end_bright[v]);
     }
-    l.ends.push_back(0);
     l.contributed = c.decoder.lcd_history == LcdHistory::Contributed;
     const std::vector<std::int64_t>& rom = target.rom();
     std::vector<std::int64_t> step(rom.size(), 0);

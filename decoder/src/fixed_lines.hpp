@@ -54,7 +54,7 @@ struct ColumnBlendPlan {
 struct EotfPlan {
   std::vector<std::int64_t> node;
   std::vector<std::int64_t> step;
-  std::vector<std::int64_t> packed;  // node << 32 | step as 32 bits, for one gather per sample (nodes below 2^31)
+  std::vector<std::int64_t> packed;  // node << 32 | step as 32 bits, one lookup per sample (nodes below 2^31)
   std::uint32_t unit = 0;  // 2^W
   int blend_shift = 0;     // 2W - U
   int weight_bits = 0;     // U - k
@@ -174,8 +174,8 @@ struct LcdPlan {
   int width_log2 = 0;
   int top = 0;                      // 2^o - 1
   int steps = 0;                    // binary search steps that cover [0, top]
-  // Per v_{t-1}: M(0, v_{t-1})^gamma and M(1, v_{t-1})^gamma (uQ/sQ.F) side by side, the unreachable ends, read as
-  // one 128-bit load per sample; one padding word at the end.
+  // Per v_{t-1}: M(0, v_{t-1})^gamma and M(1, v_{t-1})^gamma (uQ/sQ.F) side by side, the unreachable ends (one
+  // 128-bit load per sample on AVX2).
   std::vector<std::int64_t> ends;
   bool contributed = false;              // LcdHistory::Contributed: x_{t-1} stored is the contributed value
   // The search in one gather (lcd_search_index): per row r (v_{t-1} = r, then the held row) the code is the number

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <random>
 #include <string>
@@ -88,6 +89,8 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
       {"jitter", 0.5, "vive", 8, false, false, 67},  {"panorama", 0.5, "lcd", 8, false, true, 67},
       {"discs", 0.4, "lcd", 8, true, false, 67},     {"panorama", 0.5, "vive", 8, true, true, 66},
       {"zoneplate", 0.25, "lcd", 8, false, false, 68},
+      // 203 pixels: 609 samples a line, two chunks of the kernels' lookup passes (256 samples) and a tail.
+      {"panorama", 0.5, "vive", 8, false, true, 203}, {"discs", 0.4, "lcd", 8, false, true, 203},
   };
   const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());
@@ -126,7 +129,9 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
     const auto& plan = kernels.line_plans().motion;
     ASSERT_TRUE(plan.has_value()) << "s = " << sensitivity;
     const std::int64_t one = kernels.one();
-    constexpr std::size_t kPixels = 203;  // a tail after every vector width
+    // Three chunks of the kernels' passes (256 pixels) and a tail after every vector width; pixels outside [0, 1] in
+    // each chunk.
+    constexpr std::size_t kPixels = 3 * 256 + 11;
     std::mt19937_64 random(7);
     std::uniform_int_distribution<std::int64_t> linear(0, one);
     std::uniform_int_distribution<std::int64_t> tiny(0, 12);
@@ -140,11 +145,16 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
         case 1: previous[s] = alpha[s] = 0; break;
         case 2: previous[s] = tiny(random); alpha[s] = tiny(random); break;
         case 3: previous[s] = one; alpha[s] = linear(random); break;
-        case 4: previous[s] = x == 4 ? -1 : linear(random); alpha[s] = x == 15 ? one + 1 : linear(random); break;
+        case 4:
+          previous[s] = x % 256 == 4 ? -1 : linear(random);
+          alpha[s] = x % 256 == 15 ? one + 1 : linear(random);
+          break;
         default: previous[s] = linear(random); alpha[s] = linear(random); break;
       }
       residual[s] = x % 7 == 0 ? 0 : residual_value(random);
     }
+    residual[3 * 300] = std::numeric_limits<std::int32_t>::min();  // |rho| = 2^31, past int32
+    residual[3 * 600 + 1] = std::numeric_limits<std::int32_t>::max();
     std::vector<std::int64_t> expected_weight(kPixels), expected_shown(3 * kPixels);
     fixed_detail::MotionTally expected;
     for (std::size_t x = 0; x < kPixels; ++x) {
@@ -378,7 +388,8 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
     const fixed_detail::DrivePlan& unpacked = unpacked_tables;
     const fixed_detail::DrivePlan& wide = wide_tables;
     const std::int64_t one = kernels.one();
-    std::vector<std::int64_t> values;
+    // Values outside the index first, so that the vectors after the generic search's keep their channel phase.
+    std::vector<std::int64_t> values = {-1, one + 1, std::int64_t{1} << 40};
     // Sample s is read as channel s mod 3: each channel's thresholds go to its own samples.
     for (int ch = 0; ch < 3; ++ch) {
       for (const std::int64_t t : kernels.drive_index(ch).padded()) {
