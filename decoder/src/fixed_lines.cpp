@@ -27,19 +27,28 @@ inline std::size_t next_phase(std::size_t phase, std::size_t step) {
 }
 namespace hn = hwy::HWY_NAMESPACE;
 
-// table[index] of each 64-bit lane. On four lanes (AVX2) four 128-bit loads (each word with the next: the tables
-// LookupWords reads carry one word more) and an unpack: on the CPUs measured (Zen 3) a gather of four words costs
-// several times as much.
 #if HWY_TARGET != HWY_SCALAR
+// On four 64-bit lanes (AVX2): the words table[at[i]] and table[at[i] + 1] of each lane i by four 128-bit loads, as
+// the 128-bit blocks of `low` (lanes 0 and 2) and `high` (lanes 1 and 3); InterleaveLower / InterleaveUpper of the
+// two give the first / second words in lane order. On the CPUs measured (Zen 3) a gather of four words costs several
+// times as much.
+template <class D>
+HWY_INLINE void LoadWordPairs(D d, const std::int64_t* table, hn::Vec<D> at, hn::Vec<D>& low, hn::Vec<D>& high) {
+  static_assert(hn::MaxLanes(D()) == 4);
+  HWY_ALIGN std::int64_t offset[4];
+  hn::Store(at, d, offset);
+  const hn::Half<D> dh;
+  low = hn::Combine(d, hn::LoadU(dh, table + offset[2]), hn::LoadU(dh, table + offset[0]));
+  high = hn::Combine(d, hn::LoadU(dh, table + offset[3]), hn::LoadU(dh, table + offset[1]));
+}
+
+// table[index] of each 64-bit lane (the tables LookupWords reads carry one word more, read with the last).
 template <class D>
 HWY_INLINE hn::Vec<D> LookupWords(D d, const std::int64_t* table, hn::Vec<D> index) {
   if constexpr (hn::MaxLanes(d) == 4) {
-    HWY_ALIGN std::int64_t at[4];
-    hn::Store(index, d, at);
-    const hn::Half<D> dh;
-    const auto even = hn::Combine(d, hn::LoadU(dh, table + at[2]), hn::LoadU(dh, table + at[0]));
-    const auto odd = hn::Combine(d, hn::LoadU(dh, table + at[3]), hn::LoadU(dh, table + at[1]));
-    return hn::InterleaveLower(d, even, odd);
+    hn::Vec<D> low, high;
+    LoadWordPairs(d, table, index, low, high);
+    return hn::InterleaveLower(d, low, high);
   } else {
     return hn::GatherIndex(d, table, index);
   }
@@ -77,19 +86,15 @@ HWY_INLINE hn::Vec<D> InterpolateWord(D d, hn::Vec<D> word, hn::Vec<D> weight, S
   }
 }
 
-// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1]: on four lanes (AVX2) four 128-bit loads of the
-// pairs, else two gathers.
+// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1].
 template <class D>
 HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn::Vec<D>& first, hn::Vec<D>& second) {
   const auto at = hn::Add(index, index);
   if constexpr (hn::MaxLanes(d) == 4) {
-    HWY_ALIGN std::int64_t offset[4];
-    hn::Store(at, d, offset);
-    const hn::Half<D> dh;
-    const auto even = hn::Combine(d, hn::LoadU(dh, table + offset[2]), hn::LoadU(dh, table + offset[0]));
-    const auto odd = hn::Combine(d, hn::LoadU(dh, table + offset[3]), hn::LoadU(dh, table + offset[1]));
-    first = hn::InterleaveLower(d, even, odd);
-    second = hn::InterleaveUpper(d, even, odd);
+    hn::Vec<D> low, high;
+    LoadWordPairs(d, table, at, low, high);
+    first = hn::InterleaveLower(d, low, high);
+    second = hn::InterleaveUpper(d, low, high);
   } else {
     first = hn::GatherIndex(d, table, at);
     second = hn::GatherIndex(d, table + 1, at);
