@@ -25,6 +25,22 @@ inline std::size_t next_phase(std::size_t phase, std::size_t step) {
   const std::size_t next = phase + step;
   return next >= 3 ? next - 3 : next;
 }
+
+// The kernels whose chain runs through a table lookup work a chunk of samples (pixels, in the motion test) at a time
+// in passes: the places of the table words, then the words by look_up, then the rest. A gather inside one long vector
+// loop stalled the loop's whole chain; scalar loads that do not wait on each other overlap.
+constexpr std::size_t kPassChunk = 256;
+
+// The next chunk of a kernel's passes: whole vectors of the `remaining` samples, at most kPassChunk.
+inline std::size_t pass_chunk(std::size_t remaining, std::size_t lanes) {
+  return std::min(kPassChunk, remaining / lanes * lanes);
+}
+
+// places[i] = table[places[i]] for i < n: the lookup pass.
+template <typename Word, typename Place>
+inline void look_up(const Word* table, Place* places, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) places[i] = static_cast<Place>(table[places[i]]);
+}
 namespace hn = hwy::HWY_NAMESPACE;
 
 #if HWY_TARGET != HWY_SCALAR
@@ -214,11 +230,10 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   const auto upper_weight = hn::BitCast(du32, hn::Set(du, upper));
   const auto blend_half = hn::Set(du, std::uint64_t{1} << (blend_shift - 1));
   const auto weight_mask = hn::Set(du, (std::uint64_t{1} << weight_bits) - 1);
-  // A chunk at a time in passes: the blend into `out`, the ROM words by scalar loads, the interpolation.
-  constexpr std::size_t kChunk = 256;
-  HWY_ALIGN std::int64_t words[kChunk];
+  // In passes (kPassChunk): the blend into `out`, the ROM words, the interpolation.
+  HWY_ALIGN std::int64_t words[kPassChunk];
   while (s + lanes <= n) {
-    const std::size_t count = std::min(kChunk, (n - s) / lanes * lanes);
+    const std::size_t count = pass_chunk(n - s, lanes);
     for (std::size_t i = 0; i < count; i += lanes) {
       const auto t = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, top + s + i)));
       const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s + i)));
@@ -227,7 +242,7 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
       hn::StoreU(hn::BitCast(d, upsampled), d, out + s + i);
       hn::Store(hn::BitCast(d, hn::ShiftRightSame(upsampled, weight_bits)), d, words + i);
     }
-    for (std::size_t i = 0; i < count; ++i) words[i] = packed[words[i]];
+    look_up(packed, words, count);
     for (std::size_t i = 0; i < count; i += lanes) {
       const auto weight = hn::BitCast(d, hn::And(hn::BitCast(du, hn::LoadU(d, out + s + i)), weight_mask));
       hn::StoreU(InterpolateWord(d, hn::Load(d, words + i), weight, weight_bits), d, out + s + i);
@@ -311,16 +326,14 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   };
   if (packed) {
     // One lookup per sample (DrivePlan::packed32): x's bits below its bucket's lower end against the next threshold's
-    // offset. A chunk at a time in passes: the words' places and those bits, the words by scalar loads (a gather in
-    // the vector chain stalls it), the codes.
-    constexpr std::size_t kChunk = 256;
-    HWY_ALIGN std::uint32_t words[kChunk];
-    HWY_ALIGN std::uint32_t below[kChunk];
-    std::array<bool, kChunk> by_generic_search{};
+    // offset. In passes (kPassChunk): the words' places and those bits, the words, the codes.
+    HWY_ALIGN std::uint32_t words[kPassChunk];
+    HWY_ALIGN std::uint32_t below[kPassChunk];
+    std::array<bool, kPassChunk> by_generic_search{};
     const std::int32_t* bucket_offset = p.bucket_offset32.data();  // locals: a vector store may alias the plan
     const int offset_bits = p.offset_bits;
     while (s + lanes <= n) {
-      const std::size_t count = std::min(kChunk, (n - s) / lanes * lanes);
+      const std::size_t count = pass_chunk(n - s, lanes);
       for (std::size_t i = 0; i < count; i += lanes, phase = next_phase(phase, phase_step)) {
         Place place;
         by_generic_search[i] = !place_of(s + i, place);
@@ -335,8 +348,7 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
         const auto below_bits = hn::Sub(hn::Shl(one32, hn::BitCast(du, hn::Max(hn::Sub(place.octave, hn::BitCast(d, one32)), hn::Zero(d)))), one32);
         hn::Store(hn::IfThenZeroElse(hn::RebindMask(du, small), hn::And(hn::BitCast(du, place.x), below_bits)), du, below + i);
       }
-      const auto* packed_table = reinterpret_cast<const std::uint32_t*>(packed_words);
-      for (std::size_t i = 0; i < count; ++i) words[i] = packed_table[words[i]];
+      look_up(reinterpret_cast<const std::uint32_t*>(packed_words), words, count);
       for (std::size_t i = 0; i < count; i += lanes) {
         if (by_generic_search[i]) continue;
         const auto word = hn::Load(du, words + i);
@@ -423,12 +435,10 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
     hn::StoreU(clamped, d, shown + at);
     hn::StoreU(hn::Sub(beta, clamped), d, rho + at);
   };
-  // lin(E) a chunk of samples at a time by scalar loads (the ROM is small; a gather costs more than the loads and
-  // stalls the vector chain), then the split.
-  constexpr std::size_t kChunk = 256;
-  HWY_ALIGN std::int64_t full[kChunk];
+  // In passes (kPassChunk): lin(E) by scalar loads from the codes themselves, then the split.
+  HWY_ALIGN std::int64_t full[kPassChunk];
   while (s + lanes <= n) {
-    const std::size_t count = std::min(kChunk, (n - s) / lanes * lanes);
+    const std::size_t count = pass_chunk(n - s, lanes);
     for (std::size_t i = 0; i < count; ++i) full[i] = code_rom[codes[s + i]];
     for (std::size_t i = 0; i < count; i += lanes) split(hn::Load(d, full + i), s + i);
     s += count;
@@ -802,21 +812,16 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
       finish(s, x, x_previous, sum, j, search(j));
     }
   } else {
-    // Through the index, a chunk of samples at a time in passes: m's ROM places, its ROM words by scalar loads, m and
-    // the index words' places, those words by scalar loads, then the codes. A vector's own lookups would stall its
-    // chain; loads independent of each other overlap.
-    constexpr std::size_t kChunk = 256;
-    HWY_ALIGN std::int64_t targets[kChunk];
-    HWY_ALIGN std::int64_t words[kChunk];
-    HWY_ALIGN std::int64_t held_codes[kChunk];
-    HWY_ALIGN std::int64_t rom_weights[kChunk];
-    HWY_ALIGN std::int64_t rom_shifts[kChunk];
+    // Through the index, in passes (kPassChunk): m's ROM places, its ROM words, m and the index words' places, those
+    // words, then the codes.
+    HWY_ALIGN std::int64_t targets[kPassChunk];
+    HWY_ALIGN std::int64_t words[kPassChunk];
+    HWY_ALIGN std::int64_t held_codes[kPassChunk];
+    HWY_ALIGN std::int64_t rom_weights[kPassChunk];
+    HWY_ALIGN std::int64_t rom_shifts[kPassChunk];
     const std::uint32_t* index = p.index.data();
-    const auto look_up = [&](std::size_t m) {
-      for (std::size_t i = 0; i < m; ++i) words[i] = index[words[i]];
-    };
     while (s + lanes <= n) {
-      const std::size_t m = std::min(kChunk, (n - s) / lanes * lanes);
+      const std::size_t m = pass_chunk(n - s, lanes);
       for (std::size_t i = 0; i < m; i += lanes) {  // m's ROM places, then its words
         const auto x = hn::LoadU(d, wanted + s + i);
         const RomPlace place = target_place(hn::Add(x, previous_of(s + i, x)));
@@ -824,7 +829,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
         hn::Store(place.weight, d, rom_weights + i);
         hn::Store(place.scale_bits, d, rom_shifts + i);
       }
-      for (std::size_t i = 0; i < m; ++i) targets[i] = target_packed[targets[i]];
+      look_up(target_packed, targets, m);
       for (std::size_t i = 0; i < m; i += lanes) {
         const auto x = hn::LoadU(d, wanted + s + i);
         const auto target = target_from(hn::Add(x, previous_of(s + i, x)), hn::Load(d, targets + i),
@@ -832,7 +837,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
         hn::Store(target, d, targets + i);
         hn::Store(LcdIndexAt(d, shape, target, held ? held_row : previous_row(s + i)), d, words + i);
       }
-      look_up(m);
+      look_up(index, words, m);
       if (held) {  // v_{t-1} from the held row, then the code from v_{t-1}'s row
         for (std::size_t i = 0; i < m; i += lanes) {
           const auto target = hn::Load(d, targets + i);
@@ -840,7 +845,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
           hn::Store(j, d, held_codes + i);
           hn::Store(LcdIndexAt(d, shape, target, j), d, words + i);
         }
-        look_up(m);
+        look_up(index, words, m);
       }
       for (std::size_t i = 0; i < m; i += lanes) {
         const auto x = hn::LoadU(d, wanted + s + i);
@@ -882,8 +887,6 @@ inline std::int64_t weighted_scalar(std::int64_t alpha, std::int64_t weight, std
   return s.alpha_prime;
 }
 
-constexpr std::size_t kMotionChunk = 256;  // pixels per pass of MotionWeights
-
 void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
   std::size_t x = 0;
@@ -922,7 +925,7 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   const Rom reciprocal{p.reciprocal.packed.data(), p.reciprocal.weight_bits};
   const Rom exp_fraction{p.exp_fraction.packed.data(), p.exp_fraction.weight_bits};
   // A ROM's node of code into words[i], and (after the lookup pass) its interpolation from words[i].
-  HWY_ALIGN std::int64_t words[kMotionChunk];
+  HWY_ALIGN std::int64_t words[kPassChunk];
   const auto place_in = [&](const Rom& rom, const auto code, std::size_t i) {
     hn::Store(hn::BitCast(d, hn::ShiftRightSame(code, rom.weight_bits)), d, words + i);
   };
@@ -940,17 +943,17 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero), hn::Gt(v, one)); };
   auto weight_sum = zero;
   auto underflow_lanes = zero;  // counted here, not through `tally` (a store per vector)
-  // A chunk at a time in passes, so that no ROM lookup sits inside a long vector chain: Eq. 5 up to the reciprocal
-  // ROM's places; its words by scalar loads; c and Eq. 6's places (the exp ROM and exp(-i)); their words; w. Vectors
-  // with a pixel outside the lanes take the stage functions in the first pass.
-  std::array<bool, kMotionChunk> by_stage_functions{};
-  HWY_ALIGN std::int64_t codes[kMotionChunk];  // the reciprocal ROM's input, then x = s c
-  HWY_ALIGN std::int64_t differences[kMotionChunk];  // |Yp - Ya|, 0 for a still pixel
-  HWY_ALIGN std::int64_t shifts[kMotionChunk];  // c's rounding shift
-  HWY_ALIGN std::int64_t integers[kMotionChunk];  // i, then exp(-i)
+  // In passes (kPassChunk pixels): Eq. 5 up to the reciprocal ROM's places; its words; c and Eq. 6's places (the
+  // exp ROM and exp(-i)); their words; w. Vectors with a pixel outside the lanes take the stage functions in the
+  // first pass.
+  std::array<bool, kPassChunk> by_stage_functions{};
+  HWY_ALIGN std::int64_t codes[kPassChunk];  // the reciprocal ROM's input, then x = s c
+  HWY_ALIGN std::int64_t differences[kPassChunk];  // |Yp - Ya|, 0 for a still pixel
+  HWY_ALIGN std::int64_t shifts[kPassChunk];  // c's rounding shift
+  HWY_ALIGN std::int64_t integers[kPassChunk];  // i, then exp(-i)
   const std::int64_t* exp_integer = p.exp_integer.data();
   while (x + lanes <= pixels) {
-    const std::size_t count = std::min(kMotionChunk, (pixels - x) / lanes * lanes);
+    const std::size_t count = pass_chunk(pixels - x, lanes);
     for (std::size_t i = 0; i < count; i += lanes) {
       const std::size_t at = x + i;
       hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
@@ -984,7 +987,7 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
       hn::Store(difference, d, differences + i);
       hn::Store(hn::IfThenElse(still, unit, contrast_shift), d, shifts + i);
     }
-    for (std::size_t i = 0; i < count; ++i) words[i] = reciprocal.packed[words[i]];
+    look_up(reciprocal.packed, words, count);
     for (std::size_t i = 0; i < count; i += lanes) {
       if (by_stage_functions[i]) {
         hn::Store(zero, d, words + i);
@@ -1003,10 +1006,8 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
       place_in(exp_fraction, hn::And(exponent, fraction_mask), i);
       hn::Store(hn::Min(hn::BitCast(d, hn::ShiftRightSame(exponent, exp_input_frac_bits)), fifteen), d, integers + i);
     }
-    for (std::size_t i = 0; i < count; ++i) {
-      words[i] = exp_fraction.packed[words[i]];
-      integers[i] = exp_integer[integers[i]];
-    }
+    look_up(exp_fraction.packed, words, count);
+    look_up(exp_integer, integers, count);
     for (std::size_t i = 0; i < count; i += lanes) {
       if (by_stage_functions[i]) continue;
       const std::size_t at = x + i;
