@@ -178,7 +178,7 @@ struct LcdPlan {
   // 128-bit load per sample on AVX2).
   std::vector<std::int64_t> ends;
   bool contributed = false;              // LcdHistory::Contributed: x_{t-1} stored is the contributed value
-  // The search in one gather (lcd_search_index): per row r (v_{t-1} = r, then the held row) the code is the number
+  // The search in one lookup (lcd_search_index): per row r (v_{t-1} = r, then the held row) the code is the number
   // of its thresholds U_k = ceil(merge[r][k] / scale) (the smallest target m with m scale >= merge) at or below m.
   // Where every bucket of 2^index_shift targets holds at most one threshold besides its lower end, and every
   // threshold lies in [1, one] (so a target clamped to [0, one] has its code), word [r index_buckets + q] holds the

@@ -672,7 +672,7 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   EXPECT_TRUE(plans_of(oled).drive.has_value());
   EXPECT_TRUE(plans_of(oled).motion.has_value());
   EXPECT_TRUE(plans_of(oled).gaussian.has_value());
-  EXPECT_FALSE(plans_of(oled).drive->packed32.empty()) << "the OLED drive search in one gather at 8 bits";
+  EXPECT_FALSE(plans_of(oled).drive->packed32.empty()) << "the OLED drive search in one lookup at 8 bits";
   EXPECT_FALSE(plans_of(fixed_config(link_config(0.5, 0, false, 10), "vive")).gaussian.has_value());
   FixedDecoderConfig still = oled;
   still.decoder.sensitivity = 0.0;  // w = 1 everywhere: the stage function's shortcut
