@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #if defined(__linux__)
@@ -171,14 +172,38 @@ void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* 
   lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper), *eotf, out);
 }
 
+void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
+                                std::int32_t* out, ColumnBlendCache& cache) const {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
+  const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
+  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
+                         *kernels_.line_plans().eotf, out);
+}
+
 void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,
                                  const std::uint16_t* codes_row, const std::uint16_t* low0, const std::uint16_t* low1,
                                  std::int32_t* residual_row, bool lost, bool grey, LineScratch& scratch) const {
   const int samples = 3 * g.full.width;
   const auto n = static_cast<std::size_t>(samples);
+  const FixedLinePlans& plans = kernels_.line_plans();
+  if (!lost && narrow_lines(out)) {  // the line kernels on 32-bit lines, the same steps as below
+    scratch.first32.resize(n);
+    scratch.shown32.resize(n);
+    scratch.rho32.resize(n);
+    upsample(low0, low1, g, y, scratch.first32.data(), scratch.first_rows);  // L_t
+    const std::uint64_t clipped = lines::compensate(codes_row, scratch.first32.data(), n, plans,
+                                                    scratch.shown32.data(), scratch.rho32.data());
+    out.tally.clipped += clipped;
+    out.tally.counts.beta_clipped += clipped;
+    lines::drive_codes(scratch.shown32.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+    ResidualTally stored;
+    lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
+    out.tally.add(stored);
+    return;
+  }
   scratch.first.resize(n);
   upsample(low0, low1, g, y, scratch.first.data(), grey, scratch.first_rows);  // L_t
-  const FixedLinePlans& plans = kernels_.line_plans();
   // An LCD line: its drive over the line too (the eye's first frame included), whose shortfall joins rho (Sec. 4.4).
   const bool lcd_line = !line_kernels(out) && line_values(out) && plans.lcd;
   if (lost || !(line_kernels(out) || lcd_line)) {
@@ -215,19 +240,12 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
                                     const ReducedLineGate* gate, bool grey, LineScratch& scratch) const {
   const int samples = 3 * g.full.width;
   const auto n = static_cast<std::size_t>(samples);
-  scratch.first.resize(n);
-  upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);  // Eq. 1: alpha
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
   const bool previous_needed = (residual_row != nullptr || residual_zero) && !motion_static;
-  if (previous_needed) {  // L_{t-1} from the stored d_{t-1} rows
-    scratch.second.resize(n);
-    upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
-  }
   // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line (an
   // LCD's one sample after the other, as emit takes them: a reduced frame passes on no shortfall).
   const bool whole_line = line_values(out);
-  if (whole_line) scratch.shown.resize(n);
   const std::optional<MotionPlan>& motion = kernels_.line_plans().motion;
   if (whole_line && motion && (residual_row != nullptr || residual_zero)) {
     // Eqs. 4-6 over the line: w per pixel (1 on a static line, as reduced_pixel takes it), then alpha'. A line whose
@@ -243,12 +261,37 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     if (motion_static) {
       std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
       m.weight_sum = kernels_.one() * static_cast<Raw>(pixels);
-    } else {
-      lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,
-                            scratch.weight.data(), m);
     }
-    lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
-                                  scratch.shown.data(), m);
+    // Eq. 1's alpha, L_{t-1} from the stored d_{t-1} rows, w, alpha' and its drive codes, on lines of 64-bit or (the
+    // OLED where the formats allow) 32-bit words.
+    const auto weighted = [&](auto& first, auto& second, auto& shown) {
+      first.resize(n);
+      second.resize(n);
+      shown.resize(n);
+      const auto upsampled = [&](const std::uint16_t* row0, const std::uint16_t* row1, auto& line,
+                                 ColumnBlendCache& cache) {
+        if constexpr (std::is_same_v<decltype(line.data()), Raw*>) {
+          upsample(row0, row1, g, y, line.data(), grey, cache);
+        } else {
+          upsample(row0, row1, g, y, line.data(), cache);
+        }
+      };
+      upsampled(in0, in1, first, scratch.first_rows);
+      if (!motion_static) {
+        upsampled(prev0, prev1, second, scratch.second_rows);
+        lines::motion_weights(second.data(), first.data(), pixels, *motion, kernels_, scratch.weight.data(), m);
+      }
+      lines::add_weighted_residuals(first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
+                                    shown.data(), m);
+    };
+    if (narrow_lines(out)) {
+      weighted(scratch.first32, scratch.second32, scratch.shown32);
+      lines::drive_codes(scratch.shown32.data(), n, *kernels_.line_plans().drive,
+                         out.frame.drive_codes.ptr<std::uint16_t>(y));
+    } else {
+      weighted(scratch.first, scratch.second, scratch.shown);
+      emit_line(out, eye, y, scratch.shown.data(), nullptr);
+    }
     FrameTally& t = out.tally;
     t.weight_sum += m.weight_sum;
     t.counts.weight_underflow += m.underflow;
@@ -257,9 +300,15 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     t.dropped_sum += m.dropped_sum;
     t.residual_abs_sum += m.residual_abs_sum;
     t.residual_abs_max = std::max(t.residual_abs_max, m.residual_abs_max);
-    emit_line(out, eye, y, scratch.shown.data(), nullptr);
     return;
   }
+  scratch.first.resize(n);
+  upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);  // Eq. 1: alpha
+  if (previous_needed) {  // L_{t-1} from the stored d_{t-1} rows
+    scratch.second.resize(n);
+    upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
+  }
+  if (whole_line) scratch.shown.resize(n);
   Raw* shown = whole_line ? scratch.shown.data() : nullptr;
   for (int x = 0; x < g.full.width; ++x) {
     reduced_pixel(out, eye, y, x, scratch.first.data() + 3 * x,

@@ -119,6 +119,11 @@ struct LineScratch {
   std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
   std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho)
   std::vector<std::int32_t> zero_residual;  // the residual of a line the store holds all zero (DESIGN §7 skip)
+  // The OLED line kernels' lines in 32-bit words (FixedLinePlans::code_rom32): first, second, shown and rho.
+  std::vector<std::int32_t> first32;
+  std::vector<std::int32_t> second32;
+  std::vector<std::int32_t> shown32;
+  std::vector<std::int32_t> rho32;
 };
 
 // Output frame under construction and the per-pixel emission shared by both schedules.
@@ -254,6 +259,14 @@ class FixedDecoderCore {
   // and the cache where the plans allow, else FixedKernels::upsample_line.
   void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, Raw* out, bool grey,
                 ColumnBlendCache& cache) const;
+  // The same on a 32-bit line (the OLED line kernels').
+  void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, std::int32_t* out,
+                ColumnBlendCache& cache) const;
+  // The OLED line kernels keep a line in 32-bit words (FixedLinePlans::code_rom32) where the drive search has its
+  // 32-bit tables.
+  bool narrow_lines(const FrameOutput& out) const {
+    return line_kernels(out) && !kernels_.line_plans().drive->base32.empty();
+  }
   // The line kernels take a whole line, the OLED drive included: no report planes or taps (emit's other work).
   bool line_kernels(const FrameOutput& out) const { return line_values(out) && kernels_.line_plans().drive; }
   // A reduced-frame line's shown values over the whole line, emitted afterwards (emit_line): any panel.

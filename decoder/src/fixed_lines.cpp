@@ -213,13 +213,20 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
 #endif
 }
 
-void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                   const EotfPlan& p, std::int64_t* out) {
+// A linear value into a kernel's output line of either width (FixedLinePlans::code_rom32 says why 32 bits hold it).
+template <typename Linear>
+inline void store_linear(std::int64_t value, Linear* out) {
+  *out = static_cast<Linear>(value);
+}
+
+template <typename Linear>
+void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                       const EotfPlan& p, Linear* out) {
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
   const hn::RebindToUnsigned<decltype(d)> du;
-  const hn::Rebind<std::uint32_t, decltype(du)> d32h;  // half-width loads of the uQb.W rows
+  const hn::Rebind<std::uint32_t, decltype(du)> d32h;  // half-width loads of the uQb.W rows (and 32-bit stores)
   const hn::Repartition<std::uint32_t, decltype(du)> du32;
   const std::size_t lanes = hn::Lanes(d);
   // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
@@ -230,8 +237,9 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
   const auto upper_weight = hn::BitCast(du32, hn::Set(du, upper));
   const auto blend_half = hn::Set(du, std::uint64_t{1} << (blend_shift - 1));
   const auto weight_mask = hn::Set(du, (std::uint64_t{1} << weight_bits) - 1);
-  // In passes (kPassChunk): the blend into `out`, the ROM words, the interpolation.
+  // In passes (kPassChunk): the blend (each sample's ROM weight kept), the ROM words, the interpolation.
   HWY_ALIGN std::int64_t words[kPassChunk];
+  HWY_ALIGN std::uint64_t weights[kPassChunk];
   while (s + lanes <= n) {
     const std::size_t count = pass_chunk(n - s, lanes);
     for (std::size_t i = 0; i < count; i += lanes) {
@@ -239,21 +247,35 @@ void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::s
       const auto b = hn::BitCast(du32, hn::PromoteTo(du, hn::LoadU(d32h, bottom + s + i)));
       const auto blended = hn::Add(hn::MulEven(lower_weight, t), hn::MulEven(upper_weight, b));  // uQb.2W
       const auto upsampled = hn::ShiftRightSame(hn::Add(blended, blend_half), blend_shift);       // uQb.U
-      hn::StoreU(hn::BitCast(d, upsampled), d, out + s + i);
+      hn::Store(hn::And(upsampled, weight_mask), du, weights + i);
       hn::Store(hn::BitCast(d, hn::ShiftRightSame(upsampled, weight_bits)), d, words + i);
     }
     look_up(packed, words, count);
     for (std::size_t i = 0; i < count; i += lanes) {
-      const auto weight = hn::BitCast(d, hn::And(hn::BitCast(du, hn::LoadU(d, out + s + i)), weight_mask));
-      hn::StoreU(InterpolateWord(d, hn::Load(d, words + i), weight, weight_bits), d, out + s + i);
+      const auto weight = hn::BitCast(d, hn::Load(du, weights + i));
+      const auto linear = InterpolateWord(d, hn::Load(d, words + i), weight, weight_bits);
+      if constexpr (sizeof(Linear) == 8) {
+        hn::StoreU(linear, d, out + s + i);
+      } else {  // uQ1.F within 32 bits
+        hn::StoreU(hn::TruncateTo(d32h, hn::BitCast(du, linear)), d32h, reinterpret_cast<std::uint32_t*>(out + s + i));
+      }
     }
     s += count;
   }
 #endif
   for (; s < n; ++s) {
     const std::uint64_t blended = static_cast<std::uint64_t>(p.unit - upper) * top[s] + static_cast<std::uint64_t>(upper) * bottom[s];
-    out[s] = eotf_scalar(blended, p);
+    store_linear(eotf_scalar(blended, p), out + s);
   }
+}
+
+void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                   const EotfPlan& p, std::int64_t* out) {
+  BlendRowsEotfInto(top, bottom, n, upper, p, out);
+}
+void BlendRowsEotf32(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                     const EotfPlan& p, std::int32_t* out) {
+  BlendRowsEotfInto(top, bottom, n, upper, p, out);
 }
 
 #if HWY_TARGET != HWY_SCALAR
@@ -277,7 +299,8 @@ HWY_INLINE hn::Vec<D> IndexSearch(D d, hn::Vec<D> x, hn::Vec<D> octave, hn::Vec<
 // DriveCodes in 32-bit lanes (DrivePlan::base32 ..): the bucket from a float's exponent and fraction, exact because
 // a value of 2^24 or more (below 2^30) is converted shifted right by 6, below 2^24 and so without rounding, which keeps
 // its top m + 1 bits (m <= 17), and a smaller value is converted as it is.
-std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[maybe_unused]] std::size_t n,
+template <typename Linear>
+std::size_t DriveCodesNarrow([[maybe_unused]] const Linear* linear, [[maybe_unused]] std::size_t n,
                              [[maybe_unused]] const DrivePlan& p, [[maybe_unused]] std::uint16_t* out) {
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
@@ -308,13 +331,24 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   struct Place {
     hn::Vec<decltype(d)> x, octave, top_bits;
   };
+  const auto limit32 = hn::Set(d, static_cast<std::int32_t>(std::min<std::int64_t>(p.value_limit, INT32_MAX)));
+  const auto load_x = [&](std::size_t at, hn::Vec<decltype(d)>& x) {
+    if constexpr (sizeof(Linear) == 4) {  // value_limit <= 2^30 (base32)
+      x = hn::LoadU(d, linear + at);
+      return hn::AllFalse(d, hn::Or(hn::Lt(x, hn::Zero(d)), hn::Not(hn::Lt(x, limit32))));
+    } else {
+      const auto low = hn::LoadU(d64, linear + at);
+      const auto high = hn::LoadU(d64, linear + at + half);
+      const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero64), hn::Not(hn::Lt(v, limit64))); };
+      if (!hn::AllFalse(d64, hn::Or(outside(low), outside(high)))) return false;
+      x = hn::BitCast(d, hn::Combine(du, hn::TruncateTo(duh, hn::BitCast(du64, high)),
+                                     hn::TruncateTo(duh, hn::BitCast(du64, low))));
+      return true;
+    }
+  };
   const auto place_of = [&](std::size_t at, Place& place) {
-    const auto low = hn::LoadU(d64, linear + at);
-    const auto high = hn::LoadU(d64, linear + at + half);
-    const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero64), hn::Not(hn::Lt(v, limit64))); };
-    if (!hn::AllFalse(d64, hn::Or(outside(low), outside(high)))) return false;
-    const auto x = hn::BitCast(d, hn::Combine(du, hn::TruncateTo(duh, hn::BitCast(du64, high)),
-                                              hn::TruncateTo(duh, hn::BitCast(du64, low))));
+    hn::Vec<decltype(d)> x;
+    if (!load_x(at, x)) return false;
     const auto large = hn::Not(hn::Lt(x, exact_float));
     const auto bits = hn::BitCast(du, hn::ConvertTo(df, hn::IfThenElse(large, hn::ShiftRight<6>(x), x)));
     const auto exponent = hn::Add(hn::BitCast(d, hn::ShiftRight<23>(bits)), hn::IfThenElseZero(large, six));
@@ -373,6 +407,12 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const std::int64_t* linear, [[mayb
   }
 #endif
   return s;
+}
+
+// On a 32-bit line the vector search needs the 32-bit tables (DrivePlan::base32); without them, the generic one.
+void DriveCodes32(const std::int32_t* linear, std::size_t n, const DrivePlan& p, std::uint16_t* out) {
+  std::size_t s = p.base32.empty() ? 0 : DriveCodesNarrow(linear, n, p, out);
+  for (; s < n; ++s) out[s] = drive_scalar(linear[s], s, p);
 }
 
 void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, std::uint16_t* out) {
@@ -448,6 +488,46 @@ std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, st
   for (; s < n; ++s) {
     const std::int64_t beta = 2 * code_rom[codes[s]] - low[s];
     shown[s] = std::clamp(beta, std::int64_t{0}, one_value);
+    rho[s] = beta - shown[s];
+    clipped += shown[s] != beta ? 1 : 0;
+  }
+  return clipped;
+}
+
+// Compensate on 32-bit lines (beta in [-2^F, 2^(F+1)], F <= 28), twice the lanes and the clamp by the 32-bit minimum
+// and maximum AVX2 has.
+std::uint64_t Compensate32(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
+                           const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
+  const std::int32_t* code_rom = plans.code_rom32.data();
+  const auto one_value = static_cast<std::int32_t>(plans.one);
+  std::uint64_t clipped = 0;
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int32_t> d;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto one = hn::Set(d, one_value);
+  auto clipped_lanes = zero;
+  // In passes (kPassChunk): lin(E) by scalar loads from the codes themselves, then the split.
+  HWY_ALIGN std::int32_t full[kPassChunk];
+  while (s + lanes <= n) {
+    const std::size_t count = pass_chunk(n - s, lanes);
+    for (std::size_t i = 0; i < count; ++i) full[i] = code_rom[codes[s + i]];
+    for (std::size_t i = 0; i < count; i += lanes) {
+      const auto f = hn::Load(d, full + i);
+      const auto beta = hn::Sub(hn::Add(f, f), hn::LoadU(d, low + s + i));
+      const auto clamped = hn::Min(hn::Max(beta, zero), one);
+      clipped_lanes = CountInto(d, clipped_lanes, hn::Not(hn::Eq(clamped, beta)));
+      hn::StoreU(clamped, d, shown + s + i);
+      hn::StoreU(hn::Sub(beta, clamped), d, rho + s + i);
+    }
+    s += count;
+  }
+  clipped += Total(d, clipped_lanes);
+#endif
+  for (; s < n; ++s) {
+    const std::int32_t beta = 2 * code_rom[codes[s]] - low[s];
+    shown[s] = std::clamp(beta, std::int32_t{0}, one_value);
     rho[s] = beta - shown[s];
     clipped += shown[s] != beta ? 1 : 0;
   }
@@ -867,8 +947,11 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
 }
 
 // The motion weight of one pixel and Eq. 4 of one sample by the stage functions (tails and out-of-lane operands).
-inline std::int64_t weight_scalar(const std::int64_t* previous, const std::int64_t* alpha, const FixedKernels& kernels,
+template <typename Linear>
+inline std::int64_t weight_scalar(const Linear* previous_rgb, const Linear* alpha_rgb, const FixedKernels& kernels,
                                   MotionTally& tally) {
+  const std::int64_t previous[3] = {previous_rgb[0], previous_rgb[1], previous_rgb[2]};
+  const std::int64_t alpha[3] = {alpha_rgb[0], alpha_rgb[1], alpha_rgb[2]};
   bool underflow = false;
   const std::int64_t w = kernels.motion_weight(kernels.luma(previous), kernels.luma(alpha), underflow);
   tally.underflow += underflow ? 1 : 0;
@@ -887,8 +970,46 @@ inline std::int64_t weighted_scalar(std::int64_t alpha, std::int64_t weight, std
   return s.alpha_prime;
 }
 
-void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
-                   const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+#if HWY_TARGET != HWY_SCALAR
+// The three channels of lanes pixels from a line of either width, in 64-bit lanes.
+template <class D, typename Linear>
+HWY_INLINE void LoadLinear3(D d, const Linear* rgb, hn::Vec<D>& r, hn::Vec<D>& g, hn::Vec<D>& b) {
+  if constexpr (sizeof(Linear) == 8) {
+    hn::LoadInterleaved3(d, rgb, r, g, b);
+  } else {
+    const hn::Rebind<std::int32_t, D> d32;
+    hn::Vec<decltype(d32)> r32, g32, b32;
+    hn::LoadInterleaved3(d32, rgb, r32, g32, b32);
+    r = hn::PromoteTo(d, r32);
+    g = hn::PromoteTo(d, g32);
+    b = hn::PromoteTo(d, b32);
+  }
+}
+
+// A line of either width in 64-bit lanes, and back (the 32-bit lines hold only values within 32 bits).
+template <class D, typename Linear>
+HWY_INLINE hn::Vec<D> LoadLinear(D d, const Linear* line) {
+  if constexpr (sizeof(Linear) == 8) {
+    return hn::LoadU(d, line);
+  } else {
+    return hn::PromoteTo(d, hn::LoadU(hn::Rebind<std::int32_t, D>(), line));
+  }
+}
+template <class D, typename Linear>
+HWY_INLINE void StoreLinear(D d, hn::Vec<D> v, Linear* line) {
+  if constexpr (sizeof(Linear) == 8) {
+    hn::StoreU(v, d, line);
+  } else {
+    const hn::RebindToUnsigned<D> du;
+    const hn::Rebind<std::uint32_t, D> du32;
+    hn::StoreU(hn::TruncateTo(du32, hn::BitCast(du, v)), du32, reinterpret_cast<std::uint32_t*>(line));
+  }
+}
+#endif
+
+template <typename Linear>
+void MotionWeightsOf(const Linear* previous, const Linear* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
+                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
   std::size_t x = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -957,8 +1078,8 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
     for (std::size_t i = 0; i < count; i += lanes) {
       const std::size_t at = x + i;
       hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
-      hn::LoadInterleaved3(d, previous + 3 * at, pr, pg, pb);
-      hn::LoadInterleaved3(d, alpha + 3 * at, ar, ag, ab);
+      LoadLinear3(d, previous + 3 * at, pr, pg, pb);
+      LoadLinear3(d, alpha + 3 * at, ar, ag, ab);
       const auto out_of_lanes = hn::Or(hn::Or(hn::Or(outside(pr), outside(pg)), hn::Or(outside(pb), outside(ar))),
                                        hn::Or(outside(ag), outside(ab)));
       const auto yp = luma(pr, pg, pb);
@@ -1033,9 +1154,19 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   for (; x < pixels; ++x) weight[x] = weight_scalar(previous + 3 * x, alpha + 3 * x, kernels, tally);
 }
 
-void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
-                          std::size_t n, [[maybe_unused]] const MotionPlan& p, const FixedKernels& kernels, std::int64_t* shown,
-                          MotionTally& tally) {
+void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& p,
+                   const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+  MotionWeightsOf(previous, alpha, pixels, p, kernels, weight, tally);
+}
+void MotionWeights32(const std::int32_t* previous, const std::int32_t* alpha, std::size_t pixels, const MotionPlan& p,
+                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+  MotionWeightsOf(previous, alpha, pixels, p, kernels, weight, tally);
+}
+
+template <typename Linear>
+void AddWeightedResidualsOf(const Linear* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, [[maybe_unused]] const MotionPlan& p, const FixedKernels& kernels,
+                            Linear* shown, MotionTally& tally) {
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -1071,7 +1202,7 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
                        : hn::GatherIndex(d, weight + s / 3, pixel);
     if (!hn::AllFalse(d, hn::Or(hn::Lt(w, zero), hn::Gt(w, one)))) {
       for (std::size_t i = 0; i < lanes; ++i) {
-        shown[s + i] = weighted_scalar(alpha[s + i], weight[(s + i) / 3], residual[s + i], kernels, tally);
+        store_linear(weighted_scalar(alpha[s + i], weight[(s + i) / 3], residual[s + i], kernels, tally), shown + s + i);
       }
       continue;
     }
@@ -1079,11 +1210,11 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
     const auto rho = hn::PromoteTo(d, rho32);
     // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho (uQ1.F x sQ.R) rounded to F fraction bits.
     const auto product = hn::MulEven(hn::BitCast(di32, w), hn::BitCast(di32, rho));
-    const auto sum = hn::Add(hn::LoadU(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), residual_frac_bits));
+    const auto sum = hn::Add(LoadLinear(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), residual_frac_bits));
     // The clamp and what it drops (|sum - clamped|) from two comparisons: AVX2 has no 64-bit minimum or maximum.
     const auto negative = hn::Lt(sum, zero);
     const auto above = hn::Gt(sum, one);
-    hn::StoreU(hn::IfThenZeroElse(negative, hn::IfThenElse(above, one, sum)), d, shown + s);
+    StoreLinear(d, hn::IfThenZeroElse(negative, hn::IfThenElse(above, one, sum)), shown + s);
     clipped_lanes = CountInto(d, clipped_lanes, hn::Or(negative, above));
     dropped = hn::Add(dropped, hn::IfThenElse(negative, hn::Neg(sum), hn::IfThenElseZero(above, hn::Sub(sum, one))));
     // |rho| in 32-bit lanes, read unsigned (|INT32_MIN| = 2^31 too).
@@ -1097,7 +1228,18 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
   tally.residual_abs_max =
       std::max(tally.residual_abs_max, static_cast<std::int64_t>(hn::GetLane(hn::MaxOfLanes(du32h, magnitude_max))));
 #endif
-  for (; s < n; ++s) shown[s] = weighted_scalar(alpha[s], weight[s / 3], residual[s], kernels, tally);
+  for (; s < n; ++s) store_linear(weighted_scalar(alpha[s], weight[s / 3], residual[s], kernels, tally), shown + s);
+}
+
+void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                          std::size_t n, const MotionPlan& p, const FixedKernels& kernels, std::int64_t* shown,
+                          MotionTally& tally) {
+  AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
+}
+void AddWeightedResiduals32(const std::int32_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& p, const FixedKernels& kernels, std::int32_t* shown,
+                            MotionTally& tally) {
+  AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
 }
 
 inline std::int32_t stored_scalar(std::int64_t rho, const FixedKernels& kernels, ResidualTally& tally) {
@@ -1107,11 +1249,12 @@ inline std::int32_t stored_scalar(std::int64_t rho, const FixedKernels& kernels,
   return static_cast<std::int32_t>(stored.value);
 }
 
-void StoreResiduals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
-                    ResidualTally& tally) {
+template <typename Linear>
+void StoreResidualsOf(const Linear* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                      ResidualTally& tally) {
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
-  const hn::ScalableTag<std::int64_t> d;
+  const hn::ScalableTag<Linear> d;
   const hn::Rebind<std::int32_t, decltype(d)> d32;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
@@ -1125,6 +1268,15 @@ void StoreResiduals(const std::int64_t* rho, std::size_t n, const FixedKernels& 
   }
 #endif
   for (; s < n; ++s) stored[s] = stored_scalar(rho[s], kernels, tally);
+}
+
+void StoreResiduals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                    ResidualTally& tally) {
+  StoreResidualsOf(rho, n, kernels, stored, tally);
+}
+void StoreResiduals32(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                      ResidualTally& tally) {
+  StoreResidualsOf(rho, n, kernels, stored, tally);
 }
 
 const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
@@ -1228,6 +1380,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   plans.code_rom = kernels.code_rom();
   plans.one = kernels.one();
   const int F = c.linear_frac_bits;
+  plans.code_rom32.assign(plans.code_rom.begin(), plans.code_rom.end());
   const int W = c.bilinear_weight_frac_bits;
   const int U = c.upsample_frac_bits;
   const fx::InterpolatedLut* eotf = kernels.eotf_lut();
@@ -1547,6 +1700,37 @@ HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(StoreResiduals);
 HWY_EXPORT(TargetName);
+HWY_EXPORT(BlendRowsEotf32);
+HWY_EXPORT(DriveCodes32);
+HWY_EXPORT(Compensate32);
+HWY_EXPORT(MotionWeights32);
+HWY_EXPORT(AddWeightedResiduals32);
+HWY_EXPORT(StoreResiduals32);
+
+void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                     const EotfPlan& plan, std::int32_t* out) {
+  HWY_DYNAMIC_DISPATCH(BlendRowsEotf32)(top, bottom, n, upper, plan, out);
+}
+void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(DriveCodes32)(linear, n, plan, out);
+}
+std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
+                         const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
+  return HWY_DYNAMIC_DISPATCH(Compensate32)(codes, low, n, plans, shown, rho);
+}
+void motion_weights(const std::int32_t* previous, const std::int32_t* alpha, std::size_t pixels, const MotionPlan& plan,
+                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+  HWY_DYNAMIC_DISPATCH(MotionWeights32)(previous, alpha, pixels, plan, kernels, weight, tally);
+}
+void add_weighted_residuals(const std::int32_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
+                            MotionTally& tally) {
+  HWY_DYNAMIC_DISPATCH(AddWeightedResiduals32)(alpha, weight, residual, n, plan, kernels, shown, tally);
+}
+void store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                     ResidualTally& tally) {
+  HWY_DYNAMIC_DISPATCH(StoreResiduals32)(rho, n, kernels, stored, tally);
+}
 
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
   HWY_DYNAMIC_DISPATCH(BlendColumns)(row, plan, n, out);

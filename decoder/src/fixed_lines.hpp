@@ -203,6 +203,11 @@ struct FixedLinePlans {
   std::optional<LcdPlan> lcd;            // LCD with the merge table (output codes up to 8 bits), F <= 30
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
   std::int64_t one = 0;
+  // code_rom in 32 bits. FixedDecoderConfig bounds F to 28, so a line's linear values (uQ1.F), beta in [-2^F,
+  // 2^(F+1)], rho and alpha' all fit 32 bits, and the OLED's line kernels keep their lines in 32-bit words (the
+  // overloads below on std::int32_t lines): twice the lanes where the arithmetic is 32-bit (Eq. 2 and the split, the
+  // drive codes' input) and half the line traffic elsewhere.
+  std::vector<std::int32_t> code_rom32;
 
   static FixedLinePlans build(const FixedKernels& kernels);
 };
@@ -260,6 +265,20 @@ void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weigh
 // The residual store of a line: FixedKernels::store_residual of each rho into `stored`; a vector of zeros (beta
 // within [0, 1], the common case) stores zeros without the stage function.
 void store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                     ResidualTally& tally);
+// The same steps on 32-bit lines (FixedLinePlans::code_rom32: every value within 32 bits), the same bits;
+// drive_codes on 32-bit lines needs the plan's 32-bit tables (DrivePlan::base32) for its vector path.
+void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                     const EotfPlan& plan, std::int32_t* out);
+void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
+std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
+                         const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho);
+void motion_weights(const std::int32_t* previous, const std::int32_t* alpha, std::size_t pixels, const MotionPlan& plan,
+                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally);
+void add_weighted_residuals(const std::int32_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
+                            MotionTally& tally);
+void store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally);
 // The instruction set the kernels dispatch to on this CPU (e.g. "AVX3", "AVX2", "SSE4").
 const char* target_name();

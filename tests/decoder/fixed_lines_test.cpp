@@ -18,6 +18,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace trm {
@@ -176,14 +177,17 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
     if (sensitivity == 255.0) {
       EXPECT_GT(expected.underflow, 0u) << "the operands reach Eq. 6's underflow";
     }
-    for (const std::int64_t target : targets) {
-      const TargetMock mock(target);
-      const std::string where = std::string(hwy::TargetName(target)) + " s=" + std::to_string(sensitivity);
-      std::vector<std::int64_t> weight(kPixels), shown(3 * kPixels);
+    // The kernels on 64-bit lines and on 32-bit ones (every operand here fits 32 bits, as at F = 28).
+    const std::vector<std::int32_t> previous32(previous.begin(), previous.end());
+    const std::vector<std::int32_t> alpha32(alpha.begin(), alpha.end());
+    const auto check = [&](const auto& previous_line, const auto& alpha_line, const std::string& where) {
+      std::vector<std::int64_t> weight(kPixels);
+      std::vector<typename std::decay_t<decltype(alpha_line)>::value_type> shown(3 * kPixels);
       fixed_detail::MotionTally tally;
-      fixed_detail::lines::motion_weights(previous.data(), alpha.data(), kPixels, *plan, kernels, weight.data(), tally);
-      fixed_detail::lines::add_weighted_residuals(alpha.data(), weight.data(), residual.data(), 3 * kPixels, *plan,
-                                                  kernels, shown.data(), tally);
+      fixed_detail::lines::motion_weights(previous_line.data(), alpha_line.data(), kPixels, *plan, kernels,
+                                          weight.data(), tally);
+      fixed_detail::lines::add_weighted_residuals(alpha_line.data(), weight.data(), residual.data(), 3 * kPixels,
+                                                  *plan, kernels, shown.data(), tally);
       for (std::size_t x = 0; x < kPixels; ++x) ASSERT_EQ(weight[x], expected_weight[x]) << where << " pixel " << x;
       for (std::size_t s = 0; s < 3 * kPixels; ++s) ASSERT_EQ(shown[s], expected_shown[s]) << where << " sample " << s;
       EXPECT_EQ(tally.underflow, expected.underflow) << where;
@@ -192,6 +196,13 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
       EXPECT_EQ(tally.dropped_sum, expected.dropped_sum) << where;
       EXPECT_EQ(tally.residual_abs_sum, expected.residual_abs_sum) << where;
       EXPECT_EQ(tally.residual_abs_max, expected.residual_abs_max) << where;
+    };
+    for (const std::int64_t target : targets) {
+      const TargetMock mock(target);
+      const std::string where = std::string(hwy::TargetName(target)) + " s=" + std::to_string(sensitivity);
+      check(previous, alpha, where + " 64-bit lines");
+      check(previous32, alpha32, where + " 32-bit lines");
+      if (HasFatalFailure()) return;
     }
   }
 }
@@ -237,14 +248,22 @@ TEST(FixedLines, ResidualStoreKernelGivesTheStageFunctionsBits) {
     for (const std::int64_t target : targets) {
       const TargetMock mock(target);
       const std::string where = std::string(hwy::TargetName(target)) + (narrow ? " sQ1.6" : " default");
-      std::vector<std::int32_t> stored(kSamples, 12345);
-      fixed_detail::ResidualTally tally;
-      fixed_detail::lines::store_residuals(rho.data(), kSamples, kernels, stored.data(), tally);
-      for (std::size_t s = 0; s < kSamples; ++s) ASSERT_EQ(stored[s], expected[s]) << where << " sample " << s;
-      EXPECT_EQ(tally.saturated, expected_tally.saturated) << where;
-      EXPECT_EQ(tally.rounded, expected_tally.rounded) << where;
-      EXPECT_EQ(tally.abs_sum, expected_tally.abs_sum) << where;
-      EXPECT_EQ(tally.abs_max, expected_tally.abs_max) << where;
+      const std::vector<std::int32_t> rho32(rho.begin(), rho.end());  // the 32-bit lines (rho within [-1, 1])
+      for (const bool narrow_line : {false, true}) {
+        const std::string line = narrow_line ? ", 32-bit line" : ", 64-bit line";
+        std::vector<std::int32_t> stored(kSamples, 12345);
+        fixed_detail::ResidualTally tally;
+        if (narrow_line) {
+          fixed_detail::lines::store_residuals(rho32.data(), kSamples, kernels, stored.data(), tally);
+        } else {
+          fixed_detail::lines::store_residuals(rho.data(), kSamples, kernels, stored.data(), tally);
+        }
+        for (std::size_t s = 0; s < kSamples; ++s) ASSERT_EQ(stored[s], expected[s]) << where << line << " sample " << s;
+        EXPECT_EQ(tally.saturated, expected_tally.saturated) << where << line;
+        EXPECT_EQ(tally.rounded, expected_tally.rounded) << where << line;
+        EXPECT_EQ(tally.abs_sum, expected_tally.abs_sum) << where << line;
+        EXPECT_EQ(tally.abs_max, expected_tally.abs_max) << where << line;
+      }
     }
   }
 }
@@ -414,6 +433,18 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
     values.push_back(std::int64_t{1} << 40);
     std::vector<std::uint16_t> expected(values.size());
     for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_code(values[s], static_cast<int>(s % 3));
+    // The 32-bit lines (the 32-bit tables only): the same values but 2^40, which no 32-bit line holds.
+    std::vector<std::int32_t> values32;
+    std::vector<std::uint16_t> expected32;
+    for (std::size_t s = 0; s < values.size(); ++s) {
+      if (values[s] > std::numeric_limits<std::int32_t>::max()) continue;
+      while (values32.size() % 3 != s % 3) {
+        values32.push_back(static_cast<std::int32_t>(one / 2));
+        expected32.push_back(kernels.drive_code(one / 2, static_cast<int>((values32.size() - 1) % 3)));
+      }
+      values32.push_back(static_cast<std::int32_t>(values[s]));
+      expected32.push_back(expected[s]);
+    }
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
       const TargetMock mock(target);
       for (const fixed_detail::DrivePlan* plan : {&narrow, &unpacked, &wide}) {
@@ -423,6 +454,14 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
           ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << " " << output_bits << "-bit output, "
                                            << (plan == &wide ? "64-bit" : plan == &unpacked ? "32-bit" : "packed")
                                            << " sample " << s << " value " << values[s];
+        }
+        if (plan == &wide) continue;
+        std::vector<std::uint16_t> codes32(values32.size());
+        fixed_detail::lines::drive_codes(values32.data(), values32.size(), *plan, codes32.data());
+        for (std::size_t s = 0; s < values32.size(); ++s) {
+          ASSERT_EQ(codes32[s], expected32[s]) << hwy::TargetName(target) << " " << output_bits << "-bit output, "
+                                               << (plan == &unpacked ? "32-bit" : "packed") << " on a 32-bit line, sample "
+                                               << s << " value " << values32[s];
         }
       }
     }
@@ -473,9 +512,15 @@ TEST(FixedLines, OledDriveKernelAtOctaveAndBucketEnds) {
       for (const fixed_detail::DrivePlan* p : {&plan.value(), static_cast<const fixed_detail::DrivePlan*>(&unpacked)}) {
         std::vector<std::uint16_t> codes(values.size());
         fixed_detail::lines::drive_codes(values.data(), values.size(), *p, codes.data());
+        const std::vector<std::int32_t> values32(values.begin(), values.end());  // all below 2^30
+        std::vector<std::uint16_t> codes32(values.size());
+        fixed_detail::lines::drive_codes(values32.data(), values32.size(), *p, codes32.data());
         for (std::size_t s = 0; s < values.size(); ++s) {
           ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << " " << name
                                            << (p == &unpacked ? " two gathers" : " packed") << ", value " << values[s];
+          ASSERT_EQ(codes32[s], expected[s]) << hwy::TargetName(target) << " " << name
+                                             << (p == &unpacked ? " two gathers" : " packed") << " on a 32-bit line, value "
+                                             << values[s];
         }
       }
     }
