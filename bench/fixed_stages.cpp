@@ -264,6 +264,9 @@ void BM_LineBlendColumns(benchmark::State& state) {
 }
 BENCHMARK(BM_LineBlendColumns);
 
+// Into a 32-bit line (an OLED full frame's L_t, `<int>`) or a 64-bit one (alpha and L_{t-1}, and every LCD line,
+// `<long>`); Eq. 2 and the drive codes below likewise (OLED `<int>`).
+template <typename Line>
 void BM_LineBlendRowsEotf(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
@@ -273,7 +276,7 @@ void BM_LineBlendRowsEotf(benchmark::State& state) {
                                           g.column_blend, n, top.data());
   trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 3).data(),
                                           g.column_blend, n, bottom.data());
-  std::vector<Raw> out(n);
+  std::vector<Line> out(n);
   for (auto _ : state) {
     trm::fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n,
                                               static_cast<std::uint32_t>(g.bilinear_rows[1].upper),
@@ -282,13 +285,22 @@ void BM_LineBlendRowsEotf(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK(BM_LineBlendRowsEotf);
+BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, std::int32_t);
+BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, Raw);
 
+// A line of random linear values in [0, limit] in the line kernels' words.
+template <typename Line>
+std::vector<Line> random_line(std::size_t n, Raw limit, unsigned seed) {
+  const std::vector<Raw> values = random_linear(n, limit, seed);
+  return std::vector<Line>(values.begin(), values.end());
+}
+
+template <typename Line>
 void BM_LineCompensate(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const std::vector<std::uint16_t> codes = random_codes(3 * kWidth, kernels.max_code(), 4);
-  const std::vector<Raw> low = random_linear(3 * kWidth, kernels.one(), 5);
-  std::vector<Raw> shown(codes.size()), rho(codes.size());
+  const std::vector<Line> low = random_line<Line>(3 * kWidth, kernels.one(), 5);
+  std::vector<Line> shown(codes.size()), rho(codes.size());
   const auto& plans = kernels.line_plans();
   for (auto _ : state) {
     benchmark::DoNotOptimize(trm::fixed_detail::lines::compensate(codes.data(), low.data(), codes.size(), plans,
@@ -297,7 +309,8 @@ void BM_LineCompensate(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK(BM_LineCompensate);
+BENCHMARK_TEMPLATE(BM_LineCompensate, std::int32_t);
+BENCHMARK_TEMPLATE(BM_LineCompensate, Raw);
 
 void BM_LineMotionWeights(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
@@ -314,13 +327,15 @@ void BM_LineMotionWeights(benchmark::State& state) {
 }
 BENCHMARK(BM_LineMotionWeights);
 
+// alpha' into a 32-bit line (the OLED's, `<int>`) or a 64-bit one (the LCD's, `<long>`).
+template <typename Shown>
 void BM_LineAddWeightedResiduals(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const std::vector<Raw> alpha = random_linear(3 * kWidth, kernels.one(), 8);
   const std::vector<Raw> weight = random_linear(kWidth, kernels.one(), 9);
   const std::vector<Raw> wide_residual = random_linear(3 * kWidth, kernels.one() / 4, 10);
   const std::vector<std::int32_t> residual(wide_residual.begin(), wide_residual.end());
-  std::vector<Raw> out(alpha.size());
+  std::vector<Shown> out(alpha.size());
   for (auto _ : state) {
     trm::fixed_detail::MotionTally tally;
     trm::fixed_detail::lines::add_weighted_residuals(alpha.data(), weight.data(), residual.data(), out.size(),
@@ -329,11 +344,13 @@ void BM_LineAddWeightedResiduals(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK(BM_LineAddWeightedResiduals);
+BENCHMARK_TEMPLATE(BM_LineAddWeightedResiduals, std::int32_t);
+BENCHMARK_TEMPLATE(BM_LineAddWeightedResiduals, Raw);
 
+template <typename Line>
 void BM_LineOledDriveCodes(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
-  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 11);
+  const std::vector<Line> wanted = random_line<Line>(3 * kWidth, kernels.one(), 11);
   std::vector<std::uint16_t> codes(wanted.size());
   for (auto _ : state) {
     trm::fixed_detail::lines::drive_codes(wanted.data(), wanted.size(), *kernels.line_plans().drive, codes.data());
@@ -341,7 +358,8 @@ void BM_LineOledDriveCodes(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK(BM_LineOledDriveCodes);
+BENCHMARK_TEMPLATE(BM_LineOledDriveCodes, std::int32_t);
+BENCHMARK_TEMPLATE(BM_LineOledDriveCodes, Raw);
 
 // The LCD drive over a line after the eye's first frame, with its frame-store update (the stores are rewritten each
 // iteration from the same random history, outside the timing).

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 #include <utility>
 
 #if defined(__linux__)
@@ -262,34 +261,26 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
       std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
       m.weight_sum = kernels_.one() * static_cast<Raw>(pixels);
     }
-    // Eq. 1's alpha, L_{t-1} from the stored d_{t-1} rows, w, alpha' and its drive codes, on lines of 64-bit or (the
-    // OLED where the formats allow) 32-bit words.
-    const auto weighted = [&](auto& first, auto& second, auto& shown) {
-      first.resize(n);
-      second.resize(n);
-      shown.resize(n);
-      const auto upsampled = [&](const std::uint16_t* row0, const std::uint16_t* row1, auto& line,
-                                 ColumnBlendCache& cache) {
-        if constexpr (std::is_same_v<decltype(line.data()), Raw*>) {
-          upsample(row0, row1, g, y, line.data(), grey, cache);
-        } else {
-          upsample(row0, row1, g, y, line.data(), cache);
-        }
-      };
-      upsampled(in0, in1, first, scratch.first_rows);
-      if (!motion_static) {
-        upsampled(prev0, prev1, second, scratch.second_rows);
-        lines::motion_weights(second.data(), first.data(), pixels, *motion, kernels_, scratch.weight.data(), m);
-      }
-      lines::add_weighted_residuals(first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
-                                    shown.data(), m);
-    };
+    // Eq. 1's alpha and L_{t-1} from the stored d_{t-1} rows (64-bit lines: their kernels measured faster so), w,
+    // and alpha' into 32-bit words where the OLED's drive search reads them (narrow_lines), else 64-bit ones.
+    scratch.first.resize(n);
+    upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);
+    if (!motion_static) {
+      scratch.second.resize(n);
+      upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
+      lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,
+                            scratch.weight.data(), m);
+    }
     if (narrow_lines(out)) {
-      weighted(scratch.first32, scratch.second32, scratch.shown32);
+      scratch.shown32.resize(n);
+      lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
+                                    scratch.shown32.data(), m);
       lines::drive_codes(scratch.shown32.data(), n, *kernels_.line_plans().drive,
                          out.frame.drive_codes.ptr<std::uint16_t>(y));
     } else {
-      weighted(scratch.first, scratch.second, scratch.shown);
+      scratch.shown.resize(n);
+      lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
+                                    scratch.shown.data(), m);
       emit_line(out, eye, y, scratch.shown.data(), nullptr);
     }
     FrameTally& t = out.tally;

@@ -119,9 +119,9 @@ struct LineScratch {
   std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
   std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho)
   std::vector<std::int32_t> zero_residual;  // the residual of a line the store holds all zero (DESIGN §7 skip)
-  // The OLED line kernels' lines in 32-bit words (FixedLinePlans::code_rom32): first, second, shown and rho.
+  // The OLED line kernels' lines in 32-bit words (FixedLinePlans::code_rom32): a full line's L_t, shown and rho, a
+  // reduced line's shown.
   std::vector<std::int32_t> first32;
-  std::vector<std::int32_t> second32;
   std::vector<std::int32_t> shown32;
   std::vector<std::int32_t> rho32;
 };

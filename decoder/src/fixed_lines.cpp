@@ -219,6 +219,20 @@ inline void store_linear(std::int64_t value, Linear* out) {
   *out = static_cast<Linear>(value);
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// A 64-bit lane's value into a line of either width (a 32-bit line holds only values within 32 bits).
+template <class D, typename Linear>
+HWY_INLINE void StoreLinear(D d, hn::Vec<D> v, Linear* line) {
+  if constexpr (sizeof(Linear) == 8) {
+    hn::StoreU(v, d, line);
+  } else {
+    const hn::RebindToUnsigned<D> du;
+    const hn::Rebind<std::uint32_t, D> du32;
+    hn::StoreU(hn::TruncateTo(du32, hn::BitCast(du, v)), du32, reinterpret_cast<std::uint32_t*>(line));
+  }
+}
+#endif
+
 template <typename Linear>
 void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                        const EotfPlan& p, Linear* out) {
@@ -254,11 +268,7 @@ void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, st
     for (std::size_t i = 0; i < count; i += lanes) {
       const auto weight = hn::BitCast(d, hn::Load(du, weights + i));
       const auto linear = InterpolateWord(d, hn::Load(d, words + i), weight, weight_bits);
-      if constexpr (sizeof(Linear) == 8) {
-        hn::StoreU(linear, d, out + s + i);
-      } else {  // uQ1.F within 32 bits
-        hn::StoreU(hn::TruncateTo(d32h, hn::BitCast(du, linear)), d32h, reinterpret_cast<std::uint32_t*>(out + s + i));
-      }
+      StoreLinear(d, linear, out + s + i);
     }
     s += count;
   }
@@ -947,11 +957,8 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
 }
 
 // The motion weight of one pixel and Eq. 4 of one sample by the stage functions (tails and out-of-lane operands).
-template <typename Linear>
-inline std::int64_t weight_scalar(const Linear* previous_rgb, const Linear* alpha_rgb, const FixedKernels& kernels,
+inline std::int64_t weight_scalar(const std::int64_t* previous, const std::int64_t* alpha, const FixedKernels& kernels,
                                   MotionTally& tally) {
-  const std::int64_t previous[3] = {previous_rgb[0], previous_rgb[1], previous_rgb[2]};
-  const std::int64_t alpha[3] = {alpha_rgb[0], alpha_rgb[1], alpha_rgb[2]};
   bool underflow = false;
   const std::int64_t w = kernels.motion_weight(kernels.luma(previous), kernels.luma(alpha), underflow);
   tally.underflow += underflow ? 1 : 0;
@@ -970,46 +977,9 @@ inline std::int64_t weighted_scalar(std::int64_t alpha, std::int64_t weight, std
   return s.alpha_prime;
 }
 
-#if HWY_TARGET != HWY_SCALAR
-// The three channels of lanes pixels from a line of either width, in 64-bit lanes.
-template <class D, typename Linear>
-HWY_INLINE void LoadLinear3(D d, const Linear* rgb, hn::Vec<D>& r, hn::Vec<D>& g, hn::Vec<D>& b) {
-  if constexpr (sizeof(Linear) == 8) {
-    hn::LoadInterleaved3(d, rgb, r, g, b);
-  } else {
-    const hn::Rebind<std::int32_t, D> d32;
-    hn::Vec<decltype(d32)> r32, g32, b32;
-    hn::LoadInterleaved3(d32, rgb, r32, g32, b32);
-    r = hn::PromoteTo(d, r32);
-    g = hn::PromoteTo(d, g32);
-    b = hn::PromoteTo(d, b32);
-  }
-}
 
-// A line of either width in 64-bit lanes, and back (the 32-bit lines hold only values within 32 bits).
-template <class D, typename Linear>
-HWY_INLINE hn::Vec<D> LoadLinear(D d, const Linear* line) {
-  if constexpr (sizeof(Linear) == 8) {
-    return hn::LoadU(d, line);
-  } else {
-    return hn::PromoteTo(d, hn::LoadU(hn::Rebind<std::int32_t, D>(), line));
-  }
-}
-template <class D, typename Linear>
-HWY_INLINE void StoreLinear(D d, hn::Vec<D> v, Linear* line) {
-  if constexpr (sizeof(Linear) == 8) {
-    hn::StoreU(v, d, line);
-  } else {
-    const hn::RebindToUnsigned<D> du;
-    const hn::Rebind<std::uint32_t, D> du32;
-    hn::StoreU(hn::TruncateTo(du32, hn::BitCast(du, v)), du32, reinterpret_cast<std::uint32_t*>(line));
-  }
-}
-#endif
-
-template <typename Linear>
-void MotionWeightsOf(const Linear* previous, const Linear* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
-                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
+void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, [[maybe_unused]] const MotionPlan& p,
+                   const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
   std::size_t x = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -1078,8 +1048,8 @@ void MotionWeightsOf(const Linear* previous, const Linear* alpha, std::size_t pi
     for (std::size_t i = 0; i < count; i += lanes) {
       const std::size_t at = x + i;
       hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
-      LoadLinear3(d, previous + 3 * at, pr, pg, pb);
-      LoadLinear3(d, alpha + 3 * at, ar, ag, ab);
+      hn::LoadInterleaved3(d, previous + 3 * at, pr, pg, pb);
+      hn::LoadInterleaved3(d, alpha + 3 * at, ar, ag, ab);
       const auto out_of_lanes = hn::Or(hn::Or(hn::Or(outside(pr), outside(pg)), hn::Or(outside(pb), outside(ar))),
                                        hn::Or(outside(ag), outside(ab)));
       const auto yp = luma(pr, pg, pb);
@@ -1154,19 +1124,10 @@ void MotionWeightsOf(const Linear* previous, const Linear* alpha, std::size_t pi
   for (; x < pixels; ++x) weight[x] = weight_scalar(previous + 3 * x, alpha + 3 * x, kernels, tally);
 }
 
-void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& p,
-                   const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
-  MotionWeightsOf(previous, alpha, pixels, p, kernels, weight, tally);
-}
-void MotionWeights32(const std::int32_t* previous, const std::int32_t* alpha, std::size_t pixels, const MotionPlan& p,
-                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
-  MotionWeightsOf(previous, alpha, pixels, p, kernels, weight, tally);
-}
-
-template <typename Linear>
-void AddWeightedResidualsOf(const Linear* alpha, const std::int64_t* weight, const std::int32_t* residual,
+template <typename Shown>
+void AddWeightedResidualsOf(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
                             std::size_t n, [[maybe_unused]] const MotionPlan& p, const FixedKernels& kernels,
-                            Linear* shown, MotionTally& tally) {
+                            Shown* shown, MotionTally& tally) {
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -1210,7 +1171,7 @@ void AddWeightedResidualsOf(const Linear* alpha, const std::int64_t* weight, con
     const auto rho = hn::PromoteTo(d, rho32);
     // Eq. 4: alpha' = clamp(alpha + w rho, 0, 1); w rho (uQ1.F x sQ.R) rounded to F fraction bits.
     const auto product = hn::MulEven(hn::BitCast(di32, w), hn::BitCast(di32, rho));
-    const auto sum = hn::Add(LoadLinear(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), residual_frac_bits));
+    const auto sum = hn::Add(hn::LoadU(d, alpha + s), hn::ShiftRightSame(hn::Add(product, residual_half), residual_frac_bits));
     // The clamp and what it drops (|sum - clamped|) from two comparisons: AVX2 has no 64-bit minimum or maximum.
     const auto negative = hn::Lt(sum, zero);
     const auto above = hn::Gt(sum, one);
@@ -1236,9 +1197,9 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
                           MotionTally& tally) {
   AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
 }
-void AddWeightedResiduals32(const std::int32_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
-                            std::size_t n, const MotionPlan& p, const FixedKernels& kernels, std::int32_t* shown,
-                            MotionTally& tally) {
+void AddWeightedResidualsInto32(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                                std::size_t n, const MotionPlan& p, const FixedKernels& kernels, std::int32_t* shown,
+                                MotionTally& tally) {
   AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
 }
 
@@ -1703,8 +1664,12 @@ HWY_EXPORT(TargetName);
 HWY_EXPORT(BlendRowsEotf32);
 HWY_EXPORT(DriveCodes32);
 HWY_EXPORT(Compensate32);
-HWY_EXPORT(MotionWeights32);
-HWY_EXPORT(AddWeightedResiduals32);
+HWY_EXPORT(AddWeightedResidualsInto32);
+void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
+                            MotionTally& tally) {
+  HWY_DYNAMIC_DISPATCH(AddWeightedResidualsInto32)(alpha, weight, residual, n, plan, kernels, shown, tally);
+}
 HWY_EXPORT(StoreResiduals32);
 
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
@@ -1717,15 +1682,6 @@ void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& pla
 std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
                          const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
   return HWY_DYNAMIC_DISPATCH(Compensate32)(codes, low, n, plans, shown, rho);
-}
-void motion_weights(const std::int32_t* previous, const std::int32_t* alpha, std::size_t pixels, const MotionPlan& plan,
-                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {
-  HWY_DYNAMIC_DISPATCH(MotionWeights32)(previous, alpha, pixels, plan, kernels, weight, tally);
-}
-void add_weighted_residuals(const std::int32_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
-                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
-                            MotionTally& tally) {
-  HWY_DYNAMIC_DISPATCH(AddWeightedResiduals32)(alpha, weight, residual, n, plan, kernels, shown, tally);
 }
 void store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally) {

@@ -273,13 +273,11 @@ void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std:
 void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
 std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
                          const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho);
-void motion_weights(const std::int32_t* previous, const std::int32_t* alpha, std::size_t pixels, const MotionPlan& plan,
-                    const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally);
-void add_weighted_residuals(const std::int32_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
-                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
-                            MotionTally& tally);
 void store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally);
+void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
+                            MotionTally& tally);
 // The instruction set the kernels dispatch to on this CPU (e.g. "AVX3", "AVX2", "SSE4").
 const char* target_name();
 
