@@ -997,6 +997,9 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
   const auto luma_weight_b = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.luma_weight[2]}));
   const auto luma_half = hn::Set(du, std::uint64_t{1} << (p.luma_shift - 1));
   const auto exponent_bias = hn::Set(d, std::int64_t{1023});
+  const auto one_half = hn::Set(du32, static_cast<std::uint32_t>(p.one));
+  const auto two_to_52 = hn::Set(df, 4503599627370496.0);
+  const auto two_to_52_bits = hn::BitCast(du, two_to_52);
   // c's rounding shift is lead + (reciprocal fraction bits - F); below 1 the stage function takes the pixel.
   const auto contrast_shift_offset = hn::Set(d, std::int64_t{p.reciprocal_frac_bits - p.linear_frac_bits});
   const auto sensitivity = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.sensitivity}));
@@ -1031,7 +1034,6 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
                              hn::MulEven(luma_weight_b, hn::BitCast(du32, b)));
     return hn::BitCast(d, hn::ShiftRightSame(hn::Add(sum, luma_half), luma_shift));  // uQ1.F
   };
-  const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, zero), hn::Gt(v, one)); };
   auto weight_sum = zero;
   auto underflow_lanes = zero;  // counted here, not through `tally` (a store per vector)
   // In passes (kPassChunk pixels): Eq. 5 up to the reciprocal ROM's places; its words; c and Eq. 6's places (the
@@ -1050,18 +1052,27 @@ void MotionWeights(const std::int64_t* previous, const std::int64_t* alpha, std:
       hn::Vec<decltype(d)> pr, pg, pb, ar, ag, ab;
       hn::LoadInterleaved3(d, previous + 3 * at, pr, pg, pb);
       hn::LoadInterleaved3(d, alpha + 3 * at, ar, ag, ab);
-      const auto out_of_lanes = hn::Or(hn::Or(hn::Or(outside(pr), outside(pg)), hn::Or(outside(pb), outside(ar))),
-                                       hn::Or(outside(ag), outside(ab)));
+      // The six in [0, 1]: every 32-bit half at most one (the unsigned 32-bit maximum AVX2 has; a negative value's
+      // upper half is all ones) and every upper half zero.
+      const auto halves = [&](const auto v) { return hn::BitCast(du32, v); };
+      const auto largest_half = hn::Max(hn::Max(hn::Max(halves(pr), halves(pg)), hn::Max(halves(pb), halves(ar))),
+                                        hn::Max(halves(ag), halves(ab)));
+      const auto upper_halves = hn::ShiftRight<32>(
+          hn::BitCast(du, hn::Or(hn::Or(hn::Or(pr, pg), hn::Or(pb, ar)), hn::Or(ag, ab))));
+      const bool out_of_lanes = !hn::AllTrue(du32, hn::Eq(hn::Max(largest_half, one_half), one_half)) ||
+                                !hn::AllTrue(du, hn::Eq(upper_halves, hn::Zero(du)));
       const auto yp = luma(pr, pg, pb);
       const auto ya = luma(ar, ag, ab);
       const auto sum = hn::Add(yp, ya);                                  // uQ2.F
-      const auto difference = hn::Sub(hn::Max(yp, ya), hn::Min(yp, ya));
+      const auto difference = hn::Abs(hn::Sub(yp, ya));
       const auto still = hn::Eq(difference, zero);                       // c = 0: w = 1
-      // The leading one of the sum from its double's exponent (the sum < 2^53 is exact), then Eq. 5 by the normalised
-      // reciprocal: m's fraction aligned to the ROM's input bits is (sum - 2^lead) 2^B >> lead.
-      const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, sum)))), exponent_bias);
+      // The leading one of the sum from its double's exponent, then Eq. 5 by the normalised reciprocal: m's fraction
+      // aligned to the ROM's input bits is (sum - 2^lead) 2^B >> lead. The double is exact: the sum (below 2^52) as
+      // the fraction bits of 2^52, less 2^52 (two operations, where AVX2 has no 64-bit integer conversion).
+      const auto exact_sum = hn::Sub(hn::BitCast(df, hn::Or(hn::BitCast(du, sum), two_to_52_bits)), two_to_52);
+      const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, exact_sum))), exponent_bias);
       const auto contrast_shift = hn::Add(lead, contrast_shift_offset);
-      by_stage_functions[i] = !hn::AllFalse(d, hn::Or(out_of_lanes, hn::AndNot(still, hn::Lt(contrast_shift, unit))));
+      by_stage_functions[i] = out_of_lanes || !hn::AllFalse(d, hn::AndNot(still, hn::Lt(contrast_shift, unit)));
       if (by_stage_functions[i]) {
         for (std::size_t k = 0; k < lanes; ++k) {
           weight[at + k] = weight_scalar(previous + 3 * (at + k), alpha + 3 * (at + k), kernels, tally);

@@ -146,7 +146,8 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
         case 2: previous[s] = tiny(random); alpha[s] = tiny(random); break;
         case 3: previous[s] = one; alpha[s] = linear(random); break;
         case 4:
-          previous[s] = x % 256 == 4 ? -1 : linear(random);
+          // -1, and 2^32 (upper half 1, lower half 0: within [0, 1] by its lower half alone)
+          previous[s] = x % 256 == 4 ? -1 : x % 256 == 26 ? std::int64_t{1} << 32 : linear(random);
           alpha[s] = x % 256 == 15 ? one + 1 : linear(random);
           break;
         default: previous[s] = linear(random); alpha[s] = linear(random); break;
