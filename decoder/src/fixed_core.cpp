@@ -197,10 +197,11 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
     out.tally.counts.beta_clipped += clipped;
     lines::drive_codes(scratch.shown32.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
     ResidualTally stored;
-    lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
+    scratch.residual_nonzero = lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
     out.tally.add(stored);
     return;
   }
+  scratch.residual_nonzero.reset();
   scratch.first.resize(n);
   upsample(low0, low1, g, y, scratch.first.data(), grey, scratch.first_rows);  // L_t
   // An LCD line: its drive over the line too (the eye's first frame included), whose shortfall joins rho (Sec. 4.4).
@@ -229,7 +230,7 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
     emit_line(out, eye, y, scratch.shown.data(), nullptr);
   }
   ResidualTally stored;
-  lines::store_residuals(rho, n, kernels_, residual_row, stored);
+  scratch.residual_nonzero = lines::store_residuals(rho, n, kernels_, residual_row, stored);
   t.add(stored);
 }
 
@@ -370,14 +371,20 @@ void FixedDecoderCore::start_full_lines(EyeState& eye, const Geometry& g) const 
   eye.low_grey.assign(static_cast<std::size_t>(g.reduced.height), 0);
 }
 
-void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const {
+void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row,
+                                     const LineScratch& scratch) const {
   if (!skipping()) return;
   // The OR of the line's residual samples, accumulated as they are produced (one flip-flop) and kept as the line's
   // flag: a line held all zero is not written to the store.
   const int samples = 3 * eye.full_size.width;
-  std::int32_t any_bits = 0;  // an OR over the line, which the compiler vectorises (an all-zero line reads it all)
-  for (int i = 0; i < samples; ++i) any_bits |= residual_row[i];
-  const bool nonzero = any_bits != 0;
+  bool nonzero = false;
+  if (scratch.residual_nonzero) {
+    nonzero = *scratch.residual_nonzero;
+  } else {
+    std::int32_t any_bits = 0;  // an OR over the line, which the compiler vectorises (an all-zero line reads it all)
+    for (int i = 0; i < samples; ++i) any_bits |= residual_row[i];
+    nonzero = any_bits != 0;
+  }
   eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
   // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel).
   eye.residual_grey[static_cast<std::size_t>(y)] = FixedKernels::grey_line(residual_row, eye.full_size.width) ? 1 : 0;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <span>
 #include <vector>
@@ -119,6 +120,8 @@ struct LineScratch {
   std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
   std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho)
   std::vector<std::int32_t> zero_residual;  // the residual of a line the store holds all zero (DESIGN §7 skip)
+  // Whether the last full line's stored residual has a sample that is not 0, where its store kernel said so.
+  std::optional<bool> residual_nonzero;
   // The OLED line kernels' lines in 32-bit words (FixedLinePlans::code_rom32): a full line's L_t, shown and rho, a
   // reduced line's shown.
   std::vector<std::int32_t> first32;
@@ -221,7 +224,9 @@ class FixedDecoderCore {
   void start_full_lines(EyeState& eye, const Geometry& g) const;
   // after full-frame output line y: flags the line of the residual store whose rho is not all zero (the write
   // gate), counting the lines not written;
-  void end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row) const;
+  // (scratch.residual_nonzero, where full_line knows it, spares reading the line again)
+  void end_full_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* residual_row,
+                     const LineScratch& scratch) const;
   bool skipping() const { return config().skip_unneeded; }
   // the gate of reduced-frame output line y from the comparator flags of its source rows (row_flags(k) gives row k's
   // FixedKernels::compare_line result), counting the skip events.

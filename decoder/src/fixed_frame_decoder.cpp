@@ -144,7 +144,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
                                               low_is_grey(row.i1));
       core_->full_line(out, eye, g, y, row_of(frame.codes, y), row_of(low, row.i0), row_of(low, row.i1),
                        residual.ptr<std::int32_t>(y), lost != nullptr && lost->lost(y), grey, scratch);
-      core_->end_full_line(out, eye, y, residual.ptr<std::int32_t>(y));
+      core_->end_full_line(out, eye, y, residual.ptr<std::int32_t>(y), scratch);
     }
     eye.have_residual = true;
     eye.residual_index = frame.meta.index;

@@ -1222,9 +1222,10 @@ inline std::int32_t stored_scalar(std::int64_t rho, const FixedKernels& kernels,
 }
 
 template <typename Linear>
-void StoreResidualsOf(const Linear* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+bool StoreResidualsOf(const Linear* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                       ResidualTally& tally) {
   std::size_t s = 0;
+  std::int32_t any_bits = 0;  // the OR of the stored values
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<Linear> d;
   const hn::Rebind<std::int32_t, decltype(d)> d32;
@@ -1236,19 +1237,20 @@ void StoreResidualsOf(const Linear* rho, std::size_t n, const FixedKernels& kern
       hn::StoreU(zero32, d32, stored + s);
       continue;
     }
-    for (std::size_t i = 0; i < lanes; ++i) stored[s + i] = stored_scalar(rho[s + i], kernels, tally);
+    for (std::size_t i = 0; i < lanes; ++i) any_bits |= stored[s + i] = stored_scalar(rho[s + i], kernels, tally);
   }
 #endif
-  for (; s < n; ++s) stored[s] = stored_scalar(rho[s], kernels, tally);
+  for (; s < n; ++s) any_bits |= stored[s] = stored_scalar(rho[s], kernels, tally);
+  return any_bits != 0;
 }
 
-void StoreResiduals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+bool StoreResiduals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                     ResidualTally& tally) {
-  StoreResidualsOf(rho, n, kernels, stored, tally);
+  return StoreResidualsOf(rho, n, kernels, stored, tally);
 }
-void StoreResiduals32(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+bool StoreResiduals32(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                       ResidualTally& tally) {
-  StoreResidualsOf(rho, n, kernels, stored, tally);
+  return StoreResidualsOf(rho, n, kernels, stored, tally);
 }
 
 const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
@@ -1694,9 +1696,9 @@ std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, st
                          const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
   return HWY_DYNAMIC_DISPATCH(Compensate32)(codes, low, n, plans, shown, rho);
 }
-void store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+bool store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally) {
-  HWY_DYNAMIC_DISPATCH(StoreResiduals32)(rho, n, kernels, stored, tally);
+  return HWY_DYNAMIC_DISPATCH(StoreResiduals32)(rho, n, kernels, stored, tally);
 }
 
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
@@ -1740,9 +1742,9 @@ void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weigh
                             MotionTally& tally) {
   HWY_DYNAMIC_DISPATCH(AddWeightedResiduals)(alpha, weight, residual, n, plan, kernels, shown, tally);
 }
-void store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+bool store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally) {
-  HWY_DYNAMIC_DISPATCH(StoreResiduals)(rho, n, kernels, stored, tally);
+  return HWY_DYNAMIC_DISPATCH(StoreResiduals)(rho, n, kernels, stored, tally);
 }
 const char* target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 

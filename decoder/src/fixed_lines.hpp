@@ -263,8 +263,8 @@ void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weigh
                             std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int64_t* shown,
                             MotionTally& tally);
 // The residual store of a line: FixedKernels::store_residual of each rho into `stored`; a vector of zeros (beta
-// within [0, 1], the common case) stores zeros without the stage function.
-void store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+// within [0, 1], the common case) stores zeros without the stage function. Returns whether a stored value is not 0.
+bool store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally);
 // The same steps on 32-bit lines (FixedLinePlans::code_rom32: every value within 32 bits), the same bits;
 // drive_codes on 32-bit lines needs the plan's 32-bit tables (DrivePlan::base32) for its vector path.
@@ -273,7 +273,7 @@ void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std:
 void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
 std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
                          const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho);
-void store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+bool store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally);
 void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
                             std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,

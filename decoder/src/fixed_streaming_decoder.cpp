@@ -364,7 +364,7 @@ class StreamingView {
     const bool grey = core_.full_line_grey(out_, *delay_grey_->read(source_line(y)) != 0, *low_grey_->read(row.i0) != 0,
                                            *low_grey_->read(row.i1) != 0);
     core_.full_line(out_, *eye_, g, y, codes_row, low0, low1, residual_row, lost_line, grey, scratch_);
-    core_.end_full_line(out_, *eye_, y, residual_row);
+    core_.end_full_line(out_, *eye_, y, residual_row, scratch_);
   }
 
   void reduced_input(int k, const std::uint16_t* codes) {

@@ -250,12 +250,20 @@ TEST(FixedLines, ResidualStoreKernelGivesTheStageFunctionsBits) {
         const std::string line = narrow_line ? ", 32-bit line" : ", 64-bit line";
         std::vector<std::int32_t> stored(kSamples, 12345);
         fixed_detail::ResidualTally tally;
-        if (narrow_line) {
-          fixed_detail::lines::store_residuals(rho32.data(), kSamples, kernels, stored.data(), tally);
-        } else {
-          fixed_detail::lines::store_residuals(rho.data(), kSamples, kernels, stored.data(), tally);
-        }
+        const bool nonzero = narrow_line
+                                 ? fixed_detail::lines::store_residuals(rho32.data(), kSamples, kernels, stored.data(), tally)
+                                 : fixed_detail::lines::store_residuals(rho.data(), kSamples, kernels, stored.data(), tally);
         for (std::size_t s = 0; s < kSamples; ++s) ASSERT_EQ(stored[s], expected[s]) << where << line << " sample " << s;
+        EXPECT_EQ(nonzero, std::any_of(expected.begin(), expected.end(), [](std::int32_t v) { return v != 0; }))
+            << where << line;
+        // A line of zeros, and one whose rho rounds to zero in the narrow store (|rho| below its half LSB).
+        std::vector<std::int32_t> zeros(kSamples, 7);
+        const std::vector<std::int64_t> tiny(kSamples, narrow ? 1 : 0);
+        const std::vector<std::int32_t> tiny32(tiny.begin(), tiny.end());
+        fixed_detail::ResidualTally ignored;
+        EXPECT_FALSE(narrow_line ? fixed_detail::lines::store_residuals(tiny32.data(), kSamples, kernels, zeros.data(), ignored)
+                                 : fixed_detail::lines::store_residuals(tiny.data(), kSamples, kernels, zeros.data(), ignored))
+            << where << line << ": nothing but zeros stored";
         EXPECT_EQ(tally.saturated, expected_tally.saturated) << where << line;
         EXPECT_EQ(tally.rounded, expected_tally.rounded) << where << line;
         EXPECT_EQ(tally.abs_sum, expected_tally.abs_sum) << where << line;
