@@ -572,9 +572,9 @@ DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::
   // The mask first, as the other decoders check it; a view with no intact line is a lost view and its codes are not
   // looked at.
   if (detail::classify_arrival(frame, line_intact, lost, kWho) == detail::Arrival::Lost) return decode_lost(frame.meta);
-  detail::check_link_frame(frame, core_->config().decoder.link, kWho);
-  begin_view(frame.meta);
   const bool whole = std::all_of(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
+  detail::check_link_frame(frame, core_->config().decoder.link, kWho, whole ? core_->config().threads : 1);
+  begin_view(frame.meta);
   if (whole && core_->config().threads > 1) return decode_in_bands(frame);
   for (int y = 0; y < frame.codes.rows; ++y) {
     take_line(frame.codes.ptr<std::uint16_t>(y), line_intact.empty() || line_intact[static_cast<std::size_t>(y)] != 0);

@@ -5,7 +5,10 @@
 #include "trm/resample.hpp"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
+#include <thread>
+#include <vector>
 
 namespace trm::detail {
 namespace {
@@ -46,7 +49,7 @@ std::string expected_size_text(const FrameMeta& meta, const EncoderConfig& link,
 
 }  // namespace
 
-void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who) {
+void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who, int threads) {
   const FrameMeta& meta = frame.meta;
   const std::string what = who + ": " + frame_name(meta) + ": ";
   const cv::Size expected = check_header_format(meta, link, what);
@@ -63,7 +66,21 @@ void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const s
   if (frame.codes.size() != expected) {
     throw std::invalid_argument(what + "codes are " + codes_size + expected_size_text(meta, link, expected));
   }
-  const int highest = highest_code(frame.codes);
+  // Bands of at least 64 rows each (a thread costs about as much as scanning a few rows).
+  constexpr int kMinScanRows = 64;
+  const int bands = std::clamp(std::min(threads, frame.codes.rows / kMinScanRows), 1, kMaxDecoderThreads);
+  std::array<std::uint16_t, kMaxDecoderThreads> band_highest{};
+  const auto scan = [&](int b) {
+    const int first = frame.codes.rows * b / bands;
+    const int end = frame.codes.rows * (b + 1) / bands;
+    band_highest[static_cast<std::size_t>(b)] = highest_code(frame.codes.rowRange(first, end));
+  };
+  {
+    std::vector<std::jthread> helpers;
+    for (int b = 1; b < bands; ++b) helpers.emplace_back(scan, b);
+    scan(0);
+  }  // joined
+  const int highest = *std::max_element(band_highest.begin(), band_highest.begin() + bands);
   if (highest > (1 << link.bits) - 1) {
     throw std::invalid_argument(what + "code " + std::to_string(highest) + " exceeds the " +
                                 std::to_string(link.bits) + "-bit range");

@@ -17,8 +17,10 @@ std::string frame_name(const FrameMeta& meta);
 
 // Throws std::invalid_argument "<who>: <frame name>: <problem>" unless the view is one the link configuration can
 // produce: valid metadata, the link's bits and transfer, non-empty CV_16UC3 codes of the metadata's size, that size
-// the view's full or reduced size, and no code beyond the link bit depth.
-void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who);
+// the view's full or reduced size, and no code beyond the link bit depth. The codes are scanned on `threads` threads
+// (bands of rows): a frame's codes are read from memory once before the decode reads them again, and the decoder's
+// threads are idle until it is checked.
+void check_link_frame(const LinkFrame& frame, const EncoderConfig& link, const std::string& who, int threads = 1);
 
 // The metadata checks of check_link_frame for a view that arrives line by line (no codes yet): valid metadata, the
 // link's bits and transfer, and metadata width x height the view's full or reduced size.

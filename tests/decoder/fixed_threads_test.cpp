@@ -122,6 +122,40 @@ TEST(FixedThreads, ShortViewsRunOnFewerThreadsAndCountsOutOfRangeAreRejected) {
   }
 }
 
+// The range check of a view's codes runs on the decoder's threads (bands of rows) before any stage: a code beyond the
+// link's range in any band, the last included, is rejected with the one-thread message, and the decoder's state is
+// untouched (the views after it decode as on a decoder that never saw it).
+TEST(FixedThreads, AnOutOfRangeCodeInAnyScanBandIsRejectedBeforeAnyWork) {
+  const EncoderConfig link = link_config(0.5);
+  const auto frames = encode_sequence(scene_images("panorama", kWidth, 200, 4), link);  // 3 scan bands at 3 threads
+  FixedStreamingDecoder one(fixed_config(link));
+  FixedStreamingDecoder three(with_threads(fixed_config(link), 3));
+  for (const int row : {0, 100, 199}) {
+    LinkFrame bad = frames[2];
+    bad.codes = frames[2].codes.clone();
+    bad.codes.at<cv::Vec3w>(row, kWidth - 1)[2] = 256;
+    if (row == 0) {
+      const DecodedFrame a = one.decode(frames[0]);
+      const DecodedFrame b = three.decode(frames[0]);
+      expect_identical_outputs(a, one.last_counts(), b, three.last_counts(), "view 0");
+      const DecodedFrame c = one.decode(frames[1]);
+      const DecodedFrame d = three.decode(frames[1]);
+      expect_identical_outputs(c, one.last_counts(), d, three.last_counts(), "view 1");
+    }
+    const std::string expected = test::error_of([&] { one.decode(bad); });
+    EXPECT_NE(expected.find("code 256 exceeds the 8-bit range"), std::string::npos) << expected;
+    EXPECT_EQ(test::error_of([&] { three.decode(bad); }), expected) << "row " << row;
+  }
+  FixedStreamingDecoder never_saw_it(fixed_config(link));
+  for (std::size_t n = 0; n < frames.size(); ++n) {
+    const DecodedFrame reference = never_saw_it.decode(frames[n]);
+    if (n < 2) continue;
+    const DecodedFrame b = three.decode(frames[n]);
+    expect_identical_outputs(reference, never_saw_it.last_counts(), b, three.last_counts(),
+                             "view " + std::to_string(n) + " after the rejections");
+  }
+}
+
 // Without the report planes: the same drive codes, statistics and counters, the planes empty, for OLED and LCD,
 // both schedules, and the held output of a lost view is the codes alone.
 TEST(FixedThreads, DriveCodesWithoutReportPlanesAreTheSameBits) {
