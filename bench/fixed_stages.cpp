@@ -241,7 +241,7 @@ void BM_LineUpsampleEotf(benchmark::State& state) {
     trm::fixed_detail::lines::blend_columns(row1.data(), g.column_blend, n, bottom.data());
     trm::fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n,
                                               static_cast<std::uint32_t>(g.bilinear_rows[1].upper),
-                                              *kernels.line_plans().eotf, out.data());
+                                              g.column_blend.weight_bits, *kernels.line_plans().eotf, out.data());
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
@@ -265,11 +265,13 @@ void BM_LineBlendColumns(benchmark::State& state) {
 BENCHMARK(BM_LineBlendColumns);
 
 // Into a 32-bit line (an OLED full frame's L_t, `<int>`) or a 64-bit one (alpha and L_{t-1}, and every LCD line,
-// `<long>`); Eq. 2 and the drive codes below likewise (OLED `<int>`).
+// `<long>`); Eq. 2 and the drive codes below likewise (OLED `<int>`). Arg: 0 = as the decoder runs it at r = 1/2
+// (quarter weights: the exact blend, one node per sample), 1 = the ROM interpolation every other r takes.
 template <typename Line>
 void BM_LineBlendRowsEotf(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const int column_bits = state.range(0) == 0 ? g.column_blend.weight_bits : 31;
   const auto n = static_cast<std::size_t>(3 * kWidth);
   std::vector<std::uint32_t> top(n), bottom(n);
   trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 2).data(),
@@ -279,14 +281,14 @@ void BM_LineBlendRowsEotf(benchmark::State& state) {
   std::vector<Line> out(n);
   for (auto _ : state) {
     trm::fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n,
-                                              static_cast<std::uint32_t>(g.bilinear_rows[1].upper),
+                                              static_cast<std::uint32_t>(g.bilinear_rows[1].upper), column_bits,
                                               *kernels.line_plans().eotf, out.data());
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, std::int32_t);
-BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, Raw);
+BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, std::int32_t)->Arg(0)->Arg(1);
+BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, Raw)->Arg(0)->Arg(1);
 
 // A line of random linear values in [0, limit] in the line kernels' words.
 template <typename Line>

@@ -168,7 +168,8 @@ void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* 
   // Every channel, grey or not: the grey line's copies are the same bits, and the vector lanes cost no more.
   const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
   const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
-  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper), *eotf, out);
+  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
+                         g.column_blend.weight_bits, *eotf, out);
 }
 
 void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
@@ -177,7 +178,7 @@ void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* 
   const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
   const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
   lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
-                         *kernels_.line_plans().eotf, out);
+                         g.column_blend.weight_bits, *kernels_.line_plans().eotf, out);
 }
 
 void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,

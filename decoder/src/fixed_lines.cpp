@@ -233,9 +233,45 @@ HWY_INLINE void StoreLinear(D d, hn::Vec<D> v, Linear* line) {
 }
 #endif
 
+// BlendRowsEotfInto where the blend is exact above the ROM's input (EotfPlan::node32): one 32-bit node per sample.
+template <typename Linear>
+void BlendRowsEotfExact(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                        int column_bits, int row_bits, const EotfPlan& p, Linear* out) {
+  const int down = p.frac_bits - column_bits;  // T = T' 2^down exactly
+  const std::uint32_t r = upper >> (p.frac_bits - row_bits);
+  const std::uint32_t r_other = (std::uint32_t{1} << row_bits) - r;
+  const int up = p.segments_log2 - column_bits - row_bits;
+  const std::int32_t* node = p.node32.data();
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::uint32_t> du;
+  const std::size_t lanes = hn::Lanes(du);
+  const auto weight = hn::Set(du, r);
+  const auto other_weight = hn::Set(du, r_other);
+  // In passes (kPassChunk): the nodes' places, then the nodes by scalar loads.
+  HWY_ALIGN std::uint32_t places[kPassChunk];
+  while (s + lanes <= n) {
+    const std::size_t count = pass_chunk(n - s, lanes);
+    for (std::size_t i = 0; i < count; i += lanes) {
+      const auto t = hn::ShiftRightSame(hn::LoadU(du, top + s + i), down);
+      const auto b = hn::ShiftRightSame(hn::LoadU(du, bottom + s + i), down);
+      hn::Store(hn::ShiftLeftSame(hn::Add(hn::Mul(other_weight, t), hn::Mul(weight, b)), up), du, places + i);
+    }
+    for (std::size_t i = 0; i < count; ++i) out[s + i] = node[places[i]];
+    s += count;
+  }
+#endif
+  for (; s < n; ++s) out[s] = node[(r_other * (top[s] >> down) + r * (bottom[s] >> down)) << up];
+}
+
 template <typename Linear>
 void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                       const EotfPlan& p, Linear* out) {
+                       int column_bits, const EotfPlan& p, Linear* out) {
+  const int row_bits = upper == 0 ? 0 : p.frac_bits - std::countr_zero(upper);
+  if (!p.node32.empty() && column_bits + row_bits <= p.segments_log2) {
+    BlendRowsEotfExact(top, bottom, n, upper, column_bits, row_bits, p, out);
+    return;
+  }
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -280,12 +316,12 @@ void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, st
 }
 
 void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                   const EotfPlan& p, std::int64_t* out) {
-  BlendRowsEotfInto(top, bottom, n, upper, p, out);
+                   int column_bits, const EotfPlan& p, std::int64_t* out) {
+  BlendRowsEotfInto(top, bottom, n, upper, column_bits, p, out);
 }
 void BlendRowsEotf32(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                     const EotfPlan& p, std::int32_t* out) {
-  BlendRowsEotfInto(top, bottom, n, upper, p, out);
+                     int column_bits, const EotfPlan& p, std::int32_t* out) {
+  BlendRowsEotfInto(top, bottom, n, upper, column_bits, p, out);
 }
 
 #if HWY_TARGET != HWY_SCALAR
@@ -1379,6 +1415,11 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     e.unit = std::uint32_t{1} << W;
     e.blend_shift = 2 * W - U;
     e.weight_bits = weight_bits;
+    e.frac_bits = W;
+    e.segments_log2 = c.eotf_segments_per_code_log2;
+    if (std::all_of(rom.begin(), rom.end(), [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; })) {
+      e.node32.assign(rom.begin(), rom.end());
+    }
     std::optional<std::vector<std::int64_t>> packed = packed_rom(e.node, e.step);
     if (steps_fit && packed) {
       e.packed = std::move(*packed);
@@ -1569,6 +1610,7 @@ std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& 
 ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
   ColumnBlendPlan plan;
   plan.unit = unit;
+  const int W = std::countr_zero(unit);
   const std::size_t samples = 3 * static_cast<std::size_t>(g.full.width);
   plan.left.resize(samples);
   plan.right.resize(samples);
@@ -1581,6 +1623,7 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
       plan.right[s] = 3 * col.i1 + ch;
       plan.upper[s] = static_cast<std::uint32_t>(col.upper);
     }
+    if (col.upper != 0) plan.weight_bits = std::max(plan.weight_bits, W - std::countr_zero(static_cast<std::uint32_t>(col.upper)));
   }
   // Blocks of `lanes` output samples, each with a window of `span` row samples from its first tap.
   const auto build = [&](std::size_t lanes, std::size_t span) {
@@ -1686,8 +1729,8 @@ void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weigh
 HWY_EXPORT(StoreResiduals32);
 
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                     const EotfPlan& plan, std::int32_t* out) {
-  HWY_DYNAMIC_DISPATCH(BlendRowsEotf32)(top, bottom, n, upper, plan, out);
+                     int column_weight_bits, const EotfPlan& plan, std::int32_t* out) {
+  HWY_DYNAMIC_DISPATCH(BlendRowsEotf32)(top, bottom, n, upper, column_weight_bits, plan, out);
 }
 void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(DriveCodes32)(linear, n, plan, out);
@@ -1705,8 +1748,8 @@ void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::s
   HWY_DYNAMIC_DISPATCH(BlendColumns)(row, plan, n, out);
 }
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                     const EotfPlan& plan, std::int64_t* out) {
-  HWY_DYNAMIC_DISPATCH(BlendRowsEotf)(top, bottom, n, upper, plan, out);
+                     int column_weight_bits, const EotfPlan& plan, std::int64_t* out) {
+  HWY_DYNAMIC_DISPATCH(BlendRowsEotf)(top, bottom, n, upper, column_weight_bits, plan, out);
 }
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(DriveCodes)(linear, n, plan, out);

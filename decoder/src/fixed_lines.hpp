@@ -39,6 +39,9 @@ struct ColumnBlendPlan {
   // samples read as two vectors, each tap taken from one of their permutations: taps in [0, 2L). The kernel takes the
   // single windows where both fit.
   std::array<Windows, 3> double_windows;
+  // The least q with every weight `upper` a multiple of 2^(W - q) (2 at r = 1/2: quarters): U's row blend takes its
+  // exact path where this and the row weight's q add up to at most the EOTF ROM's segment bits (blend_rows_eotf).
+  int weight_bits = 0;
   static const Windows* of_width(const std::array<Windows, 3>& set, std::size_t lanes) {
     for (std::size_t i = 0; i < set.size(); ++i) {
       if ((std::size_t{4} << i) == lanes) return set[i].start.empty() ? nullptr : &set[i];
@@ -58,6 +61,13 @@ struct EotfPlan {
   std::uint32_t unit = 0;  // 2^W
   int blend_shift = 0;     // 2W - U
   int weight_bits = 0;     // U - k
+  // Where the blend's weights are multiples of 2^-q_c (columns) and 2^-q_r (the row) with q_c + q_r <= k, as at
+  // r = 1/2 (quarters, k = 4 by default), the exact blend has no bits below the ROM's input code: every sample's ROM
+  // weight is 0 and its value the node at ((2^q_r - r) T + r B) 2^(k - q_c - q_r), with T, B the column blends over
+  // 2^(W - q_c) and r the row weight over 2^(W - q_r): one lookup of a 32-bit node, no 64-bit arithmetic.
+  int frac_bits = 0;                   // W
+  int segments_log2 = 0;               // k
+  std::vector<std::int32_t> node32;    // node in 32 bits (uQ1.F, F <= 28)
 };
 
 // The OLED drive code search (ThresholdIndex) of the three channels in one table each, for interleaved samples:
@@ -224,9 +234,10 @@ namespace lines {
 
 // out[s] = (2^W - upper[s]) row[left[s]] + upper[s] row[right[s]] for s < n (uQb.W, exact).
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out);
-// out[s] = lin(round((2^W - upper) top[s] + upper bottom[s]) to uQb.U) through the EOTF ROM, uQ1.F.
+// out[s] = lin(round((2^W - upper) top[s] + upper bottom[s]) to uQb.U) through the EOTF ROM, uQ1.F; top and bottom
+// are column blends whose weights are multiples of 2^-column_weight_bits (ColumnBlendPlan::weight_bits).
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                     const EotfPlan& plan, std::int64_t* out);
+                     int column_weight_bits, const EotfPlan& plan, std::int64_t* out);
 // out[s] = the drive code of linear[s] (channel s mod 3), as ThresholdIndex::search gives it.
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
 // Eq. 2 and the split (FixedKernels::compensate): beta = 2 lin(codes[s]) - low[s] (lin through plans.code_rom),
@@ -269,7 +280,7 @@ bool store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels&
 // The same steps on 32-bit lines (FixedLinePlans::code_rom32: every value within 32 bits), the same bits;
 // drive_codes on 32-bit lines needs the plan's 32-bit tables (DrivePlan::base32) for its vector path.
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                     const EotfPlan& plan, std::int32_t* out);
+                     int column_weight_bits, const EotfPlan& plan, std::int32_t* out);
 void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
 std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
                          const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho);

@@ -18,6 +18,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace trm {
@@ -572,6 +573,62 @@ TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
           ASSERT_EQ(out[s], expected[s]) << hwy::TargetName(target) << " width " << width << " r " << r
                                          << (p == &plan ? " windows" : p == &double_only ? " double windows" : " gather")
                                          << " sample " << s;
+        }
+      }
+    }
+  }
+}
+
+// U's row blend and EOTF over every output row of a view against the per-sample U (FixedKernels::upsample_line), on
+// 64- and 32-bit lines: at r = 1/2 through the exact path (quarter weights: one ROM node per sample), at r = 0.4 and
+// 3/4 through the ROM interpolation, and at r = 1/2 with the exact path refused (a column weight's bits said too
+// many), on every instruction set. Random codes, and the rows of black and of the top code.
+TEST(FixedLines, RowBlendGivesThePerSampleUpsampleOnEveryRow) {
+  std::mt19937_64 random(37);
+  // 202 pixels at r = 1/2: an exact factor 2, quarter weights; 203: 102 reduced columns, weights of no short fraction.
+  for (const auto& [width, r, exact] : {std::tuple{202, 0.5, true}, std::tuple{202, 0.5, false},
+                                        std::tuple{203, 0.5, false}, std::tuple{203, 0.4, false},
+                                        std::tuple{67, 0.75, false}}) {
+    fixed_detail::FixedKernels kernels(fixed_config(link_config(r), "vive"));
+    const fixed_detail::Geometry& g = kernels.geometry(cv::Size(width, 14));
+    const fixed_detail::EotfPlan& eotf = *kernels.line_plans().eotf;
+    // Refused: a column weight's bits said to be more than the ROM's segment bits.
+    const int column_bits = exact || width != 202 ? g.column_blend.weight_bits : eotf.segments_log2 + 1;
+    if (width == 202) {
+      ASSERT_EQ(g.column_blend.weight_bits, 2) << "quarter weights at r = 1/2";
+      ASSERT_EQ(eotf.segments_log2, 4);
+      ASSERT_FALSE(eotf.node32.empty());
+    } else {
+      ASSERT_GT(g.column_blend.weight_bits, eotf.segments_log2) << "r = " << r << " takes the interpolation";
+    }
+    const std::size_t row_samples = 3 * static_cast<std::size_t>(g.reduced.width);
+    std::vector<std::vector<std::uint16_t>> rows(static_cast<std::size_t>(g.reduced.height),
+                                                 std::vector<std::uint16_t>(row_samples));
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      for (std::uint16_t& code : rows[k]) code = k == 1 ? 0 : k == 2 ? 255 : static_cast<std::uint16_t>(random() % 256);
+    }
+    const std::size_t n = 3 * static_cast<std::size_t>(width);
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      for (int y = 0; y < g.full.height; ++y) {
+        const fixed_detail::BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+        const auto& row0 = rows[static_cast<std::size_t>(row.i0)];
+        const auto& row1 = rows[static_cast<std::size_t>(row.i1)];
+        std::vector<std::int64_t> expected(n);
+        kernels.upsample_line(row0.data(), row1.data(), g, row.upper, expected.data(), false);
+        std::vector<std::uint32_t> top(n), bottom(n);
+        fixed_detail::lines::blend_columns(row0.data(), g.column_blend, n, top.data());
+        fixed_detail::lines::blend_columns(row1.data(), g.column_blend, n, bottom.data());
+        std::vector<std::int64_t> wide(n);
+        std::vector<std::int32_t> narrow(n);
+        const auto upper = static_cast<std::uint32_t>(row.upper);
+        fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n, upper, column_bits, eotf, wide.data());
+        fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n, upper, column_bits, eotf, narrow.data());
+        for (std::size_t s = 0; s < n; ++s) {
+          ASSERT_EQ(wide[s], expected[s]) << hwy::TargetName(target) << " r " << r << (exact ? " exact" : "")
+                                          << " row " << y << " sample " << s << ", 64-bit line";
+          ASSERT_EQ(narrow[s], expected[s]) << hwy::TargetName(target) << " r " << r << (exact ? " exact" : "")
+                                            << " row " << y << " sample " << s << ", 32-bit line";
         }
       }
     }
