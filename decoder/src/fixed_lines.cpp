@@ -40,9 +40,12 @@ inline std::size_t pass_chunk(std::size_t remaining, std::size_t lanes) {
 // r = 1/2) pass through the first and second level caches between two output lines and push the tables out, and a
 // lookup pass would then wait on each table line in turn. (For the OLED drive search's larger table it measured
 // slower: only U's nodes take it.)
+// A table larger than a first-level data cache (32 KiB) is not fetched whole.
 template <typename Word>
 inline void prefetch_table(const std::vector<Word>& table) {
   constexpr std::size_t kWordsPerLine = 64 / sizeof(Word);
+  constexpr std::size_t kMaxWords = (std::size_t{32} << 10) / sizeof(Word);
+  if (table.size() > kMaxWords) return;
   for (std::size_t i = 0; i < table.size(); i += kWordsPerLine) __builtin_prefetch(table.data() + i);
 }
 
@@ -279,7 +282,7 @@ template <typename Linear>
 void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                        int column_bits, const EotfPlan& p, Linear* out) {
   const int row_bits = upper == 0 ? 0 : p.frac_bits - std::countr_zero(upper);
-  if (!p.node32.empty() && column_bits + row_bits <= p.segments_log2) {
+  if (!p.node32.empty() && upper <= p.unit && column_bits + row_bits <= p.segments_log2) {
     BlendRowsEotfExact(top, bottom, n, upper, column_bits, row_bits, p, out);
     return;
   }
@@ -513,60 +516,28 @@ void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, s
   for (; s < n; ++s) out[s] = drive_scalar(linear[s], s, p);
 }
 
-std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n, const FixedLinePlans& plans,
-                         std::int64_t* shown, std::int64_t* rho) {
-  const std::int64_t* code_rom = plans.code_rom.data();
-  const std::int64_t one_value = plans.one;
+// Eq. 2 and the split on lines of either width: the 32-bit lines (beta in [-2^F, 2^(F+1)], F <= 28) take twice the
+// lanes and the clamp by the 32-bit minimum and maximum AVX2 has, where the 64-bit ones are emulated.
+template <typename Linear>
+std::uint64_t CompensateOf(const std::uint16_t* codes, const Linear* low, std::size_t n, const FixedLinePlans& plans,
+                           Linear* shown, Linear* rho) {
+  const Linear* code_rom = nullptr;
+  if constexpr (sizeof(Linear) == 4) {
+    code_rom = plans.code_rom32.data();
+  } else {
+    code_rom = plans.code_rom.data();
+  }
+  const auto one_value = static_cast<Linear>(plans.one);
   std::uint64_t clipped = 0;
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
-  const hn::ScalableTag<std::int64_t> d;
-  const std::size_t lanes = hn::Lanes(d);
-  const auto zero = hn::Zero(d);
-  const auto one = hn::Set(d, one_value);
-  auto clipped_lanes = zero;
-  const auto split = [&](const auto full, std::size_t at) {
-    const auto beta = hn::Sub(hn::Add(full, full), hn::LoadU(d, low + at));
-    const auto clamped = hn::Min(hn::Max(beta, zero), one);
-    clipped_lanes = CountInto(d, clipped_lanes, hn::Not(hn::Eq(clamped, beta)));
-    hn::StoreU(clamped, d, shown + at);
-    hn::StoreU(hn::Sub(beta, clamped), d, rho + at);
-  };
-  // In passes (kPassChunk): lin(E) by scalar loads from the codes themselves, then the split.
-  HWY_ALIGN std::int64_t full[kPassChunk];
-  while (s + lanes <= n) {
-    const std::size_t count = pass_chunk(n - s, lanes);
-    for (std::size_t i = 0; i < count; ++i) full[i] = code_rom[codes[s + i]];
-    for (std::size_t i = 0; i < count; i += lanes) split(hn::Load(d, full + i), s + i);
-    s += count;
-  }
-  clipped += Total(d, clipped_lanes);
-#endif
-  for (; s < n; ++s) {
-    const std::int64_t beta = 2 * code_rom[codes[s]] - low[s];
-    shown[s] = std::clamp(beta, std::int64_t{0}, one_value);
-    rho[s] = beta - shown[s];
-    clipped += shown[s] != beta ? 1 : 0;
-  }
-  return clipped;
-}
-
-// Compensate on 32-bit lines (beta in [-2^F, 2^(F+1)], F <= 28), twice the lanes and the clamp by the 32-bit minimum
-// and maximum AVX2 has.
-std::uint64_t Compensate32(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
-                           const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
-  const std::int32_t* code_rom = plans.code_rom32.data();
-  const auto one_value = static_cast<std::int32_t>(plans.one);
-  std::uint64_t clipped = 0;
-  std::size_t s = 0;
-#if HWY_TARGET != HWY_SCALAR
-  const hn::ScalableTag<std::int32_t> d;
+  const hn::ScalableTag<Linear> d;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, one_value);
   auto clipped_lanes = zero;
   // In passes (kPassChunk): lin(E) by scalar loads from the codes themselves, then the split.
-  HWY_ALIGN std::int32_t full[kPassChunk];
+  HWY_ALIGN Linear full[kPassChunk];
   while (s + lanes <= n) {
     const std::size_t count = pass_chunk(n - s, lanes);
     for (std::size_t i = 0; i < count; ++i) full[i] = code_rom[codes[s + i]];
@@ -583,12 +554,21 @@ std::uint64_t Compensate32(const std::uint16_t* codes, const std::int32_t* low, 
   clipped += Total(d, clipped_lanes);
 #endif
   for (; s < n; ++s) {
-    const std::int32_t beta = 2 * code_rom[codes[s]] - low[s];
-    shown[s] = std::clamp(beta, std::int32_t{0}, one_value);
+    const Linear beta = static_cast<Linear>(2 * code_rom[codes[s]] - low[s]);
+    shown[s] = std::clamp(beta, Linear{0}, one_value);
     rho[s] = beta - shown[s];
     clipped += shown[s] != beta ? 1 : 0;
   }
   return clipped;
+}
+
+std::uint64_t Compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n, const FixedLinePlans& plans,
+                         std::int64_t* shown, std::int64_t* rho) {
+  return CompensateOf(codes, low, n, plans, shown, rho);
+}
+std::uint64_t Compensate32(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
+                           const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
+  return CompensateOf(codes, low, n, plans, shown, rho);
 }
 
 void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
