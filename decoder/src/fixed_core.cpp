@@ -157,6 +157,22 @@ const std::uint32_t* ColumnBlendCache::row(const std::uint16_t* codes, int index
   return e.blended.data();
 }
 
+namespace {
+
+// U and lin() of output line y through the line kernels: the column blends of its two source rows (cached), then
+// the row blend and the EOTF, into a line of either width.
+template <typename Line>
+void blend_line(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, const EotfPlan& eotf,
+                ColumnBlendCache& cache, Line* out) {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
+  const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
+  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
+                         g.column_blend.weight_bits, eotf, out);
+}
+
+}  // namespace
+
 void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
                                 Raw* out, bool grey, ColumnBlendCache& cache) const {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
@@ -166,19 +182,12 @@ void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* 
     return;
   }
   // Every channel, grey or not: the grey line's copies are the same bits, and the vector lanes cost no more.
-  const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
-  const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
-  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
-                         g.column_blend.weight_bits, *eotf, out);
+  blend_line(row0, row1, g, y, *eotf, cache, out);
 }
 
 void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
                                 std::int32_t* out, ColumnBlendCache& cache) const {
-  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
-  const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
-  const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
-  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
-                         g.column_blend.weight_bits, *kernels_.line_plans().eotf, out);
+  blend_line(row0, row1, g, y, *kernels_.line_plans().eotf, cache, out);
 }
 
 void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry& g, int y,

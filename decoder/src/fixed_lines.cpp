@@ -1712,29 +1712,9 @@ HWY_EXPORT(BlendRowsEotf32);
 HWY_EXPORT(DriveCodes32);
 HWY_EXPORT(Compensate32);
 HWY_EXPORT(AddWeightedResidualsInto32);
-void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
-                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
-                            MotionTally& tally) {
-  HWY_DYNAMIC_DISPATCH(AddWeightedResidualsInto32)(alpha, weight, residual, n, plan, kernels, shown, tally);
-}
 HWY_EXPORT(StoreResiduals32);
 
-void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
-                     int column_weight_bits, const EotfPlan& plan, std::int32_t* out) {
-  HWY_DYNAMIC_DISPATCH(BlendRowsEotf32)(top, bottom, n, upper, column_weight_bits, plan, out);
-}
-void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
-  HWY_DYNAMIC_DISPATCH(DriveCodes32)(linear, n, plan, out);
-}
-std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
-                         const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
-  return HWY_DYNAMIC_DISPATCH(Compensate32)(codes, low, n, plans, shown, rho);
-}
-bool store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
-                     ResidualTally& tally) {
-  return HWY_DYNAMIC_DISPATCH(StoreResiduals32)(rho, n, kernels, stored, tally);
-}
-
+// Each step on 64-bit lines, then (where the decoder has one) its overload on 32-bit lines.
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
   HWY_DYNAMIC_DISPATCH(BlendColumns)(row, plan, n, out);
 }
@@ -1742,12 +1722,23 @@ void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std:
                      int column_weight_bits, const EotfPlan& plan, std::int64_t* out) {
   HWY_DYNAMIC_DISPATCH(BlendRowsEotf)(top, bottom, n, upper, column_weight_bits, plan, out);
 }
+void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                     int column_weight_bits, const EotfPlan& plan, std::int32_t* out) {
+  HWY_DYNAMIC_DISPATCH(BlendRowsEotf32)(top, bottom, n, upper, column_weight_bits, plan, out);
+}
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(DriveCodes)(linear, n, plan, out);
+}
+void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(DriveCodes32)(linear, n, plan, out);
 }
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
                          const FixedLinePlans& plans, std::int64_t* shown, std::int64_t* rho) {
   return HWY_DYNAMIC_DISPATCH(Compensate)(codes, low, n, plans, shown, rho);
+}
+std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, std::size_t n,
+                         const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho) {
+  return HWY_DYNAMIC_DISPATCH(Compensate32)(codes, low, n, plans, shown, rho);
 }
 void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
                       std::int64_t* out) {
@@ -1776,9 +1767,18 @@ void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weigh
                             MotionTally& tally) {
   HWY_DYNAMIC_DISPATCH(AddWeightedResiduals)(alpha, weight, residual, n, plan, kernels, shown, tally);
 }
+void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
+                            std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
+                            MotionTally& tally) {
+  HWY_DYNAMIC_DISPATCH(AddWeightedResidualsInto32)(alpha, weight, residual, n, plan, kernels, shown, tally);
+}
 bool store_residuals(const std::int64_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally) {
   return HWY_DYNAMIC_DISPATCH(StoreResiduals)(rho, n, kernels, stored, tally);
+}
+bool store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
+                     ResidualTally& tally) {
+  return HWY_DYNAMIC_DISPATCH(StoreResiduals32)(rho, n, kernels, stored, tally);
 }
 const char* target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 
