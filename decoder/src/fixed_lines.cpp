@@ -1235,10 +1235,107 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
                           MotionTally& tally) {
   AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
 }
+// Eq. 4 into a 32-bit line in 32-bit lanes (MotionPlan::narrow_weighted_sum: alpha, w, rho of the residual format
+// and alpha + w rho all within 32 bits): twice the samples per vector of AddWeightedResidualsOf, where the clamp is AVX2's native 32-bit
+// minimum and maximum. w rho is a 64-bit product of the even lanes and one of the odd lanes; the rounded shift by R
+// keeps bits [R, R + 32) of each, which a logical shift right (even) or left by 32 - R (odd) puts in the lane's
+// 32-bit half, equal to the arithmetic shift's low half for R <= 32. Vectors with an operand outside [0, 1] (w,
+// alpha) or a residual outside its format take the stage functions. Returns the samples done; the caller does the rest.
+std::size_t AddWeightedResidualsNarrow([[maybe_unused]] const std::int64_t* alpha,
+                                       [[maybe_unused]] const std::int64_t* weight,
+                                       [[maybe_unused]] const std::int32_t* residual, [[maybe_unused]] std::size_t n,
+                                       [[maybe_unused]] const MotionPlan& p,
+                                       [[maybe_unused]] const FixedKernels& kernels,
+                                       [[maybe_unused]] std::int32_t* shown, [[maybe_unused]] MotionTally& tally) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int32_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Repartition<std::int64_t, decltype(d)> d64;
+  const hn::RebindToUnsigned<decltype(d64)> du64;
+  const std::size_t lanes = hn::Lanes(d);
+  const std::size_t pixels_read = lanes / 2;  // one vector of 64-bit weights
+  // The pixels of `lanes` samples span up to (lanes + 1) / 3 + 1 of them: within one weight vector from 8 lanes on.
+  if (lanes < 8 || !p.narrow_weighted_sum) return 0;
+  const auto zero = hn::Zero(d);
+  const auto one = hn::Set(d, static_cast<std::int32_t>(p.one));
+  const auto one_u = hn::BitCast(du, one);
+  const auto magnitude_limit = hn::Set(du, p.residual_magnitude_limit);
+  const int residual_frac_bits = p.residual_frac_bits;
+  const int odd_shift = 32 - residual_frac_bits;
+  const auto residual_half = hn::Set(du64, std::uint64_t{1} << (residual_frac_bits - 1));
+  const auto low_halves = hn::Set(du64, std::uint64_t{0xFFFFFFFF});
+  // Element e: 2 (e / 3), the 32-bit half holding the weight of sample e's pixel in a vector of 64-bit weights.
+  static const std::array<std::int32_t, 3 + DrivePlan::kMaxLanes> half_of_pixel = [] {
+    std::array<std::int32_t, 3 + DrivePlan::kMaxLanes> t{};
+    for (std::size_t e = 0; e < t.size(); ++e) t[e] = static_cast<std::int32_t>(2 * (e / 3));
+    return t;
+  }();
+  auto clipped_lanes = zero;
+  auto dropped = hn::Zero(du64);
+  auto magnitude_sum = hn::Zero(du64);
+  auto magnitude_max = hn::Zero(du);
+  std::size_t phase = 0;
+  const std::size_t phase_step = lanes % 3;
+  const std::size_t pixels = n / 3;
+  for (; s + lanes <= n && s / 3 + pixels_read <= pixels; s += lanes, phase = next_phase(phase, phase_step)) {
+    const auto weights = hn::BitCast(d, hn::LoadU(d64, weight + s / 3));
+    const auto alpha_low = hn::LoadU(d64, alpha + s);
+    const auto alpha_high = hn::LoadU(d64, alpha + s + pixels_read);
+    // Every 32-bit half of the weights and alphas at most one: each in [0, 1] (a negative value's upper half is all
+    // ones, a value of 2^32 or more has a non-zero upper half).
+    const auto largest = hn::Max(hn::BitCast(du, weights),
+                                 hn::Max(hn::BitCast(du, alpha_low), hn::BitCast(du, alpha_high)));
+    // |rho| read unsigned (|INT32_MIN| = 2^31 too), within the residual format's 2^(width - 1).
+    const auto rho = hn::LoadU(d, residual + s);
+    const auto magnitude = hn::BitCast(du, hn::Abs(rho));
+    if (!hn::AllTrue(du, hn::And(hn::Eq(hn::Max(largest, one_u), one_u),
+                                 hn::Eq(hn::Max(magnitude, magnitude_limit), magnitude_limit)))) {
+      for (std::size_t i = 0; i < lanes; ++i) {
+        shown[s + i] = static_cast<std::int32_t>(
+            weighted_scalar(alpha[s + i], weight[(s + i) / 3], residual[s + i], kernels, tally));
+      }
+      continue;
+    }
+    const auto w = hn::TableLookupLanes(weights, hn::IndicesFromVec(d, hn::LoadU(d, half_of_pixel.data() + phase)));
+    const auto even = hn::BitCast(du64, hn::MulEven(w, rho));
+    const auto odd = hn::BitCast(du64, hn::MulEven(hn::BitCast(d, hn::ShiftRight<32>(hn::BitCast(du64, w))),
+                                                    hn::BitCast(d, hn::ShiftRight<32>(hn::BitCast(du64, rho)))));
+    const auto weighted = hn::OddEven(hn::BitCast(d, hn::ShiftLeftSame(hn::Add(odd, residual_half), odd_shift)),
+                                      hn::BitCast(d, hn::ShiftRightSame(hn::Add(even, residual_half), residual_frac_bits)));
+    const auto sum = hn::Add(hn::ConcatEven(d, hn::BitCast(d, alpha_high), hn::BitCast(d, alpha_low)), weighted);
+    const auto clamped = hn::Min(hn::Max(sum, zero), one);
+    hn::StoreU(clamped, d, shown + s);
+    const auto clipped = hn::Ne(clamped, sum);
+    clipped_lanes = CountInto(d, clipped_lanes, clipped);
+    if (!hn::AllFalse(d, clipped)) {  // what the clamp drops, at most 2^30 a sample: summed in 64 bits
+      const auto gap = hn::BitCast(du64, hn::Abs(hn::Sub(sum, clamped)));
+      dropped = hn::Add(dropped, hn::Add(hn::And(gap, low_halves), hn::ShiftRight<32>(gap)));
+    }
+    const auto magnitude64 = hn::BitCast(du64, magnitude);
+    magnitude_sum = hn::Add(magnitude_sum, hn::Add(hn::And(magnitude64, low_halves), hn::ShiftRight<32>(magnitude64)));
+    magnitude_max = hn::Max(magnitude_max, magnitude);
+  }
+  tally.clipped += Total(d, clipped_lanes);
+  tally.dropped_sum += static_cast<std::int64_t>(hn::GetLane(hn::SumOfLanes(du64, dropped)));
+  tally.residual_abs_sum += static_cast<std::int64_t>(hn::GetLane(hn::SumOfLanes(du64, magnitude_sum)));
+  tally.residual_abs_max =
+      std::max(tally.residual_abs_max, static_cast<std::int64_t>(hn::GetLane(hn::MaxOfLanes(du, magnitude_max))));
+#endif
+  return s;
+}
+
 void AddWeightedResidualsInto32(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
                                 std::size_t n, const MotionPlan& p, const FixedKernels& kernels, std::int32_t* shown,
                                 MotionTally& tally) {
-  AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
+  const std::size_t done = AddWeightedResidualsNarrow(alpha, weight, residual, n, p, kernels, shown, tally);
+  if (done == 0) {
+    AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
+    return;
+  }
+  for (std::size_t s = done; s < n; ++s) {
+    shown[s] = static_cast<std::int32_t>(weighted_scalar(alpha[s], weight[s / 3], residual[s], kernels, tally));
+  }
 }
 
 inline std::int32_t stored_scalar(std::int64_t rho, const FixedKernels& kernels, ResidualTally& tally) {
@@ -1349,6 +1446,10 @@ std::optional<MotionPlan> motion_plan(const FixedKernels& kernels, const std::ar
   m.exp_input_frac_bits = c.exp_input_frac_bits;
   m.exponent_shift = c.sensitivity_frac_bits + F - c.exp_input_frac_bits;
   m.residual_frac_bits = c.residual.frac_bits;
+  // |rho| <= 2^(width - 1), so |w rho| rounded to F fraction bits is at most 2^(F + int_bits - 1) + 1, and alpha +
+  // w rho with alpha in [0, 2^F] stays within 32 bits where that is at most 2^29.
+  m.narrow_weighted_sum = F + c.residual.int_bits <= 30 && m.residual_frac_bits <= 32;
+  m.residual_magnitude_limit = std::uint32_t{1} << (c.residual.width() - 1);
   const auto below32 = [](std::int64_t v) { return v >= 0 && v < (std::int64_t{1} << 32); };
   bool fits = F >= 1 && F <= 30 && m.luma_shift >= 1 && m.luma_shift + F <= 60 &&
               F + 2 + m.reciprocal_input_bits <= 63 && reciprocal.shape().output_bits <= 32 &&

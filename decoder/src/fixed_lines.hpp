@@ -153,6 +153,8 @@ struct MotionPlan {
   ShiftedRomPlan exp_fraction;    // exp(-f), f in [0, 1), uQ1.F
   std::array<std::int64_t, 16> exp_integer{};  // exp(-i), uQ1.F
   int residual_frac_bits = 0;
+  bool narrow_weighted_sum = false;  // Eq. 4's operands and sum within 32 bits (the 32-bit lanes' kernel)
+  std::uint32_t residual_magnitude_limit = 0;  // 2^(width - 1): |rho| of the residual format
 };
 
 // What the motion test and Eq. 4 of a line add to the frame's tally (FrameTally's fields of the same names).
