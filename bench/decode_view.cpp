@@ -39,12 +39,13 @@ const std::vector<LinkFrame>& pair_of_views() {
   return views;
 }
 
-// What `trm bench` calls `fixed`: drive codes only, in bands of output lines on `threads` threads.
+// What `trm bench` calls `fixed`: drive codes only (no report planes or motion weight statistics), in bands of output lines on `threads` threads.
 FixedDecoderConfig codes_only(const char* panel, std::int64_t threads) {
   FixedDecoderConfig config;
   config.decoder.link = link_config();
   config.decoder.panel = parse_panel(panel);
   config.report_planes = false;
+  config.motion_weight_statistics = false;
   config.threads = static_cast<int>(threads);
   return config;
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -252,7 +253,8 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
   const auto n = static_cast<std::size_t>(samples);
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
-  const bool previous_needed = (residual_row != nullptr || residual_zero) && !motion_static;
+  const bool weight_unused = gate != nullptr && gate->weight_unused;
+  const bool previous_needed = (residual_row != nullptr || residual_zero) && (gate == nullptr || gate->reads_previous());
   // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line (an
   // LCD's one sample after the other, as emit takes them: a reduced frame passes on no shortfall).
   const bool whole_line = line_values(out);
@@ -268,15 +270,15 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     const auto pixels = static_cast<std::size_t>(g.full.width);
     scratch.weight.resize(pixels);
     MotionTally m;
-    if (motion_static) {
+    if (motion_static || weight_unused) {  // (an unused w: any value in [0, 1] gives clamp(alpha) over zeros)
       std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
-      m.weight_sum = kernels_.one() * static_cast<Raw>(pixels);
+      m.weight_sum = motion_static ? kernels_.one() * static_cast<Raw>(pixels) : 0;
     }
     // Eq. 1's alpha and L_{t-1} from the stored d_{t-1} rows (64-bit lines: their kernels measured faster so), w,
     // and alpha' into 32-bit words where the OLED's drive search reads them (narrow_lines), else 64-bit ones.
     scratch.first.resize(n);
     upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);
-    if (!motion_static) {
+    if (previous_needed) {
       scratch.second.resize(n);
       upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
       lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,
@@ -429,14 +431,17 @@ void FixedDecoderCore::reduced_pixel(FrameOutput& out, EyeState& eye, int y, int
   const Raw* previous = motion_static ? alpha : previous_low;
   FrameTally& t = out.tally;
   bool underflow = false;
-  const Raw weight = motion_static ? kernels_.one()  // c = 0: w = 1 exactly (DESIGN §4)
-                                   : kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);
+  // An unused w (no residual, no motion statistics: a gate only without taps) is neither computed nor counted.
+  const bool weight_unused = gate != nullptr && gate->weight_unused;
+  const Raw weight = motion_static || weight_unused
+                         ? kernels_.one()  // c = 0: w = 1 exactly (DESIGN §4)
+                         : kernels_.motion_weight(kernels_.luma(previous), kernels_.luma(alpha), underflow);
   if (out.taps != nullptr) {
     for (int ch = 0; ch < 3; ++ch) tap(out, Stage::PreviousLowPass, y, x, ch, previous[ch]);
     tap(out, Stage::Contrast, y, x, 0, kernels_.motion_contrast(kernels_.luma(previous), kernels_.luma(alpha)));
     tap(out, Stage::Weight, y, x, 0, weight);
   }
-  t.weight_sum += weight;
+  if (!weight_unused) t.weight_sum += weight;
   t.counts.weight_underflow += underflow ? 1 : 0;
   WeightedSample s;
   for (int ch = 0; ch < 3; ++ch) {
@@ -512,7 +517,8 @@ DecodedFrame FixedDecoderCore::finish(FrameOutput&& out, EyeState& eye, bool ful
   if (residual_applied) {
     stats.residual_applied = true;
     stats.dropped_sum = kernels_.linear_to_double(t.dropped_sum);
-    stats.mean_motion_weight = kernels_.linear_to_double(t.weight_sum) / (samples / 3.0);
+    stats.mean_motion_weight = t.unweighed_lines > 0 ? std::numeric_limits<double>::quiet_NaN()
+                                                     : kernels_.linear_to_double(t.weight_sum) / (samples / 3.0);
   }
   stats.lcd_unreachable_fraction = static_cast<double>(t.counts.lcd_unreachable) / samples;
   last_counts_ = t.counts;

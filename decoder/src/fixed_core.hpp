@@ -24,6 +24,7 @@ struct FrameTally {
   Raw weight_sum = 0;            // uQ.F over pixels
   Raw residual_abs_sum = 0;      // in residual format LSBs
   Raw residual_abs_max = 0;
+  std::uint64_t unweighed_lines = 0;  // lines whose w was not computed (ReducedLineGate::weight_unused)
 
   // The residual store's part.
   void add(const ResidualTally& r) {
@@ -40,6 +41,7 @@ struct FrameTally {
     weight_sum += t.weight_sum;
     residual_abs_sum += t.residual_abs_sum;
     residual_abs_max = std::max(residual_abs_max, t.residual_abs_max);
+    unweighed_lines += t.unweighed_lines;
     return *this;
   }
 };
@@ -79,6 +81,11 @@ cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type);
 struct ReducedLineGate {
   bool motion_static = false;  // L_{t-1} = alpha on the whole line: w = 1, no motion test
   bool residual_zero = false;  // rho all zero on the line: no residual read, no add
+  // residual_zero without motion weight statistics (FixedDecoderConfig::motion_weight_statistics): w weighs
+  // nothing, no motion test
+  bool weight_unused = false;
+  // The motion test reads U of the d_{t-1} rows.
+  bool reads_previous() const { return !motion_static && !weight_unused; }
 };
 
 // U's column blends of the last two reduced rows read from one source (a row of d_t, i or d_{t-1} held by the
@@ -202,7 +209,7 @@ class FixedDecoderCore {
       const auto flag = [](const std::vector<std::uint8_t>& flags, int k) {
         return static_cast<std::size_t>(k) < flags.size() && flags[static_cast<std::size_t>(k)] != 0;
       };
-      grey = (gate.motion_static || (flag(eye.low_grey, row.i0) && flag(eye.low_grey, row.i1))) &&
+      grey = (!gate.reads_previous() || (flag(eye.low_grey, row.i0) && flag(eye.low_grey, row.i1))) &&
              (gate.residual_zero || flag(eye.residual_grey, y));
     }
     out.tally.counts.grey_lines += grey ? 1 : 0;
@@ -241,7 +248,10 @@ class FixedDecoderCore {
     gate.motion_static = (f0 & f1 & FixedKernels::kLineStatic) != 0;
     gate.residual_zero = eye.residual_nonzero.size() == static_cast<std::size_t>(g.full.height) &&
                          eye.residual_nonzero[static_cast<std::size_t>(y)] == 0;
-    out.tally.counts.motion_test_lines_skipped += gate.motion_static ? 1 : 0;
+    gate.weight_unused = gate.residual_zero && !gate.motion_static && !config().motion_weight_statistics &&
+                         out.taps == nullptr;
+    out.tally.unweighed_lines += gate.weight_unused ? 1 : 0;
+    out.tally.counts.motion_test_lines_skipped += gate.reads_previous() ? 0 : 1;
     out.tally.counts.residual_read_lines_skipped += gate.residual_zero ? 1 : 0;
     return gate;
   }

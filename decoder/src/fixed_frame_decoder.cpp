@@ -167,7 +167,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
     if (gated) {
       const fixed_detail::ReducedLineGate gate = core_->reduced_line_gate(
           out, eye, g, y, [&](int k) { return line_flags[static_cast<std::size_t>(k)]; });
-      const bool read_previous = !gate.motion_static;
+      const bool read_previous = gate.reads_previous();
       const bool grey = grey_of(gate);
       core_->reduced_line(out, eye, g, y, row_of(frame.codes, row.i0), row_of(frame.codes, row.i1),
                           read_previous ? row_of(eye.previous_low, row.i0) : nullptr,

@@ -397,7 +397,7 @@ class StreamingView {
         return k < first_ ? 0 : *line_flags_->read(k);
       });
     }
-    const bool read_previous = residual_applies_ && !gate.motion_static;
+    const bool read_previous = residual_applies_ && gate.reads_previous();
     const std::uint16_t* prev0 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i0) : nullptr;
     const std::uint16_t* prev1 = read_previous ? eye.previous_low.ptr<std::uint16_t>(row.i1) : nullptr;
     const std::int32_t* residual_row =

@@ -44,6 +44,8 @@ namespace {
 
 constexpr double kMiB = 1024.0 * 1024.0;
 constexpr double kRates[] = {90.0, 120.0, 144.0};
+// The drive codes alone, as `trm feed` runs the decoder: no motion test where its w goes unused.
+constexpr bool kFixedMotionWeightStatistics = false;
 
 struct BenchSize {
   int width;
@@ -269,9 +271,10 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   std::vector<Contender> contenders;
   // The hardware model's output is the drive codes: the streaming decoder without the report planes, on the
   // machine's threads and on one; then as `trm run` uses it (one thread, report planes), the frame schedule and the
-  // reference, which return the planes.
+  // reference, which return the planes. The codes alone need no motion weight statistics either.
   FixedDecoderConfig codes_only = config;
   codes_only.report_planes = false;
+  codes_only.motion_weight_statistics = kFixedMotionWeightStatistics;
   FixedDecoderConfig banded = codes_only;
   banded.threads = options.threads;
   const auto asked_for = [&options](const std::string& name) {
@@ -448,7 +451,8 @@ void register_bench(CLI::App& app, Action& action) {
       Json report = {{"machine", {{"hardware_threads", std::thread::hardware_concurrency()},
                                   {"load_average_at_start", {load[0], load[1], load[2]}}}},
                      {"parameters", {{"reduction", 0.5}, {"scene", o.scene}, {"pairs", o.pairs},
-                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats}}}};
+                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats},
+                                     {"fixed_motion_weight_statistics", kFixedMotionWeightStatistics}}}};
       Json results = Json::array();
       std::cout << "trm bench: " << std::thread::hardware_concurrency() << " hardware threads, load average "
                 << load[0] << " at start; OpenCV threads " << cv::getNumThreads() << "\n";

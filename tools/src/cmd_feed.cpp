@@ -257,6 +257,7 @@ class SendingThread {
 int run_feed(const FeedSettings& s, const PipelineOptions& options_given) {
   PipelineOptions pipeline = options_given;
   pipeline.report_planes = false;  // the rig is sent the drive codes alone
+  pipeline.motion_weight_statistics = false;
   if (s.list) {
     const rig::HidApi& api = s.hid_backend.empty() ? rig::linked_hidapi() : rig::hidapi_backend(s.hid_backend);
     std::cout << rig::format_listing(rig::list_devices(api));

@@ -40,6 +40,7 @@ struct PipelineOptions {
   int threads = 1;                    // fixed impl: FixedDecoderConfig::threads
   bool report_planes = true;          // fixed impl: FixedDecoderConfig::report_planes (not an option: trm feed,
                                       // whose rig takes the drive codes alone, turns them off)
+  bool motion_weight_statistics = true;  // fixed impl: FixedDecoderConfig::motion_weight_statistics (likewise)
 
   // Simulated display link (off when link_preset is empty and no fault or capture is asked for).
   std::string link_preset;            // dp1.2 ... custom:RATE:EFF

@@ -47,7 +47,7 @@ struct FrameStats {
   double residual_mean_abs = 0.0;      // |rho| after this frame (full frames) / of the rho consumed (reduced)
   double residual_max_abs = 0.0;
   double dropped_sum = 0.0;            // reduced frame: sum over samples of what alpha' clipping dropped
-  double mean_motion_weight = 1.0;     // reduced frame: mean w
+  double mean_motion_weight = 1.0;     // reduced frame: mean w (NaN: not measured, see motion_weight_statistics)
   bool residual_applied = false;       // reduced frame: a residual from a preceding full frame was used
   double lcd_unreachable_fraction = 0.0;
   int concealed_lines = 0;             // lines of the received view that were lost and concealed

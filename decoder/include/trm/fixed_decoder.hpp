@@ -144,8 +144,8 @@ struct FixedDecoderConfig {
   //     the d_{t-1} rows are not read (except for the exact-tie correction, where a tie made a stored code differ);
   //   * lines without clipping skip residual traffic: a full frame flags each output line whose stored rho is all
   //     zero (one bit per line); such a line is not written to the residual store, and the next reduced frame
-  //     neither reads nor adds it (alpha' = clamp(alpha)). The motion test still runs there: its w feeds the
-  //     frame's mean motion weight and underflow count;
+  //     neither reads nor adds it (alpha' = clamp(alpha)). The motion test still runs there, as its w feeds the
+  //     frame's mean motion weight and underflow count, unless motion_weight_statistics is false;
   //   * OLED has no LCD stores (v_{t-1}, x_{t-1}) in any case.
   //   * grey lines compute one channel: a line whose every pixel has R = G = B in every line it is computed from
   //     (the input line, its D taps, U's source rows, the residual line) gives the same linear light in each
@@ -160,6 +160,14 @@ struct FixedDecoderConfig {
   // 59 MiB at 2160x1200) besides the drive codes, the hardware's output. false leaves them empty: what a testbench,
   // a rig feed or a throughput run needs; the LCD's report drive value (a division per sample) is then not computed.
   bool report_planes = true;
+  // The frame's mean motion weight and weight-underflow count over every pixel of a reduced frame. On a line whose
+  // residual is all zero (the residual skip above) w weighs nothing, alpha' = clamp(alpha), and the motion test
+  // runs only for these statistics. false skips it there, with U of d_{t-1} and its reads, as a controller without
+  // these counters would (counted in motion_test_lines_skipped); the codes are the same bits, the frame's
+  // mean_motion_weight is then NaN (not measured) where a line skipped it, and weight_underflow counts the lines
+  // whose motion test ran. No effect with skip_unneeded false or with stage taps (test vectors record w everywhere).
+  // What a rig feed or a throughput run needs.
+  bool motion_weight_statistics = true;
   // FixedStreamingDecoder::decode of a whole view: bands of output lines on this many threads, each band with its
   // own line buffers (two pipelines side by side, as a wider controller would run them). Views pushed line by line
   // and views with lost lines run on one. In [1, kMaxDecoderThreads].
@@ -179,10 +187,11 @@ struct FixedStageCounts {
   std::uint64_t residual_saturated = 0;  // rho outside the residual store's range (saturated)
   std::uint64_t residual_rounded = 0;    // rho not representable exactly in the residual store (rounded)
   std::uint64_t alpha_clipped = 0;       // Eq. 4: alpha + w rho outside [0, 1] (reduced frames)
-  std::uint64_t weight_underflow = 0;    // Eq. 6: pixels with s c >= 16, w forced to 0
+  std::uint64_t weight_underflow = 0;    // Eq. 6: pixels with s c >= 16, w forced to 0 (where the test ran)
   std::uint64_t lcd_unreachable = 0;     // LCD: M(v, v_{t-1}) = m had no root in [0, 1]
   // Skip events (FixedDecoderConfig::skip_unneeded; all 0 when it is false), in output lines of the frame:
-  std::uint64_t motion_test_lines_skipped = 0;    // reduced: lines whose motion test was skipped (static, w = 1)
+  std::uint64_t motion_test_lines_skipped = 0;    // reduced: lines whose motion test was skipped (static, w = 1;
+                                                  // or no residual, without motion_weight_statistics)
   std::uint64_t residual_read_lines_skipped = 0;  // reduced: lines with no residual to read or add
   std::uint64_t residual_write_lines_skipped = 0; // full: lines whose rho is all zero (not written to the store)
   std::uint64_t grey_lines = 0;                   // output lines whose linear pipeline ran on one channel
