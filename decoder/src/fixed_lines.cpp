@@ -685,9 +685,21 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
       auto acc0 = zero;
       auto acc1 = zero;
       auto acc2 = zero;
-      for (std::size_t t = 0; t < plan.taps; ++t) {
+      // Symmetric taps (GaussianColumnsPlan::symmetric): w_t (x_t + x_{n-1-t}), the same exact sum with half the
+      // products; the middle tap of an odd count alone.
+      const std::size_t folded = plan.symmetric ? plan.taps / 2 : 0;
+      for (std::size_t t = 0; t < folded; ++t) {
+        const std::size_t mirror = plan.taps - 1 - t;
         const auto w = hn::LoadU(du, plan.planar_weight.data() + t * columns + k);
-        const std::size_t at = (t % f) * length + k + t / f;
+        const std::size_t at = plan.tap_offset[t] + k;
+        const std::size_t at_mirror = plan.tap_offset[mirror] + k;
+        acc0 = hn::Add(acc0, hn::Mul(w, hn::Add(hn::LoadU(du, red + at), hn::LoadU(du, red + at_mirror))));
+        acc1 = hn::Add(acc1, hn::Mul(w, hn::Add(hn::LoadU(du, green + at), hn::LoadU(du, green + at_mirror))));
+        acc2 = hn::Add(acc2, hn::Mul(w, hn::Add(hn::LoadU(du, blue + at), hn::LoadU(du, blue + at_mirror))));
+      }
+      for (std::size_t t = folded; t < plan.taps - folded; ++t) {
+        const auto w = hn::LoadU(du, plan.planar_weight.data() + t * columns + k);
+        const std::size_t at = plan.tap_offset[t] + k;
         acc0 = hn::Add(acc0, hn::Mul(w, hn::LoadU(du, red + at)));
         acc1 = hn::Add(acc1, hn::Mul(w, hn::LoadU(du, green + at)));
         acc2 = hn::Add(acc2, hn::Mul(w, hn::LoadU(du, blue + at)));
@@ -722,7 +734,7 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
 }
 
 void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
-                  int shift, std::uint16_t* out) {
+                  int shift, [[maybe_unused]] bool fold, std::uint16_t* out) {
   std::size_t i = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -731,9 +743,19 @@ void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, 
   const hn::Rebind<std::uint16_t, decltype(du)> d16;
   const std::size_t lanes = hn::Lanes(d);
   const auto half = hn::Set(du, std::uint64_t{1} << (shift - 1));
+  // Symmetric weights: w_j (r_j + r_{n-1-j}), the same exact sum with half the products (the pair's sum within the
+  // 32-bit operand: GaussianPlan::fold_rows).
+  bool symmetric = fold;
+  for (std::size_t j = 0; j < count / 2 && symmetric; ++j) symmetric = weight[j] == weight[count - 1 - j];
+  const std::size_t folded = symmetric ? count / 2 : 0;
   for (; i + lanes <= n; i += lanes) {
     auto acc = hn::Zero(du);
-    for (std::size_t j = 0; j < count; ++j) {
+    for (std::size_t j = 0; j < folded; ++j) {
+      const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
+      const auto pair = hn::Add(hn::LoadU(d, rows[j] + i), hn::LoadU(d, rows[count - 1 - j] + i));
+      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, pair)));
+    }
+    for (std::size_t j = folded; j < count - folded; ++j) {
       const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
       acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, hn::LoadU(d, rows[j] + i))));
     }
@@ -1547,7 +1569,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     const auto max_code = static_cast<std::uint64_t>(kernels.max_code());
     if (!kernels.linear_space() && T <= 31 && L >= 0 && T - L >= 1 && (max_code << T) < (std::uint64_t{1} << 32) &&
         (max_code << L) < (std::uint64_t{1} << 32)) {
-      plans.gaussian = GaussianPlan{T - L, T + L};
+      plans.gaussian = GaussianPlan{T - L, T + L, (max_code << (L + 1)) < (std::uint64_t{1} << 32)};
     }
   }
   if (kernels.lcd() && !kernels.lcd_merge_table_.empty() && kernels.lcd_target_lut_) {
@@ -1803,11 +1825,19 @@ GaussianColumnsPlan gaussian_columns_plan(const Geometry& g) {
   plan.columns = columns;
   plan.plane_length = columns + (plan.taps - 1) / f;
   plan.planar_weight.assign(plan.taps * columns, 0);
+  for (std::size_t t = 0; t < plan.taps; ++t) plan.tap_offset.push_back((t % f) * plan.plane_length + t / f);
   for (std::size_t k = 0; k < columns; ++k) {
     const PolyphaseTaps& taps = g.gauss_cols[k];
     for (std::size_t t = 0; t < taps.weight.size(); ++t) {
       plan.planar_weight[t * columns + k] = static_cast<std::uint32_t>(taps.weight[t]);
     }
+  }
+  plan.symmetric = true;
+  for (std::size_t t = 0; t < plan.taps / 2; ++t) {
+    const std::size_t mirror = plan.taps - 1 - t;
+    plan.symmetric = plan.symmetric && std::equal(plan.planar_weight.begin() + static_cast<std::ptrdiff_t>(t * columns),
+                                                  plan.planar_weight.begin() + static_cast<std::ptrdiff_t>((t + 1) * columns),
+                                                  plan.planar_weight.begin() + static_cast<std::ptrdiff_t>(mirror * columns));
   }
   return plan;
 }
@@ -1865,8 +1895,8 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
   HWY_DYNAMIC_DISPATCH(GaussianColumns)(row, row_samples, plan, shift, out);
 }
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
-                   int shift, std::uint16_t* out) {
-  HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, out);
+                   int shift, bool fold, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, fold, out);
 }
 void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& plan,
                 std::uint16_t* codes) {

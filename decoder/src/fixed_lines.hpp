@@ -121,12 +121,17 @@ struct GaussianColumnsPlan {
   std::int64_t first_column = 0;  // c: plane (ch, p) at m holds column clamp(c + f m + p) of the row's full_width
   std::size_t full_width = 0;
   std::vector<std::uint32_t> planar_weight;   // [t K + k]: tap slot t's weight of column k (every channel's)
+  std::vector<std::size_t> tap_offset;        // slot t's run of column 0 in a channel's planes: (t mod f) M + t div f
+  // Every column's slot weights symmetric (slot t's equal to slot taps - 1 - t's), as D's Gaussian gives them: the
+  // kernel sums the two slots' samples before one product.
+  bool symmetric = false;
 };
 
 // D's rounding shifts where its sums fit 32-bit lanes (horizontal) and 32-bit operands (vertical).
 struct GaussianPlan {
   int horizontal_shift = 0;  // T - L, half to even
   int vertical_shift = 0;    // T + L, half up
+  bool fold_rows = false;    // max_code 2^(L+1) < 2^32: two line values sum within a 32-bit operand
 };
 
 // A uniform ROM whose segment position per code is 2^k (InterpolatedLut::segment_step): node = code >> j and weight
@@ -251,8 +256,9 @@ std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, st
 void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan,
                       int shift, std::int64_t* out);
 // D's vertical half: out[i] = round(sum_j weight[j] rows[j][i], T + L), half up, for i < n (rows[j][i] < 2^32).
+// fold: rows[j][i] + rows[k][i] < 2^32 too, so that symmetric weights may be summed in pairs (GaussianPlan::fold_rows).
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
-                   int shift, std::uint16_t* out);
+                   int shift, bool fold, std::uint16_t* out);
 // The LCD drive of n samples of one line: codes[s] and, where shortfall is not null, shortfall[s] as
 // FixedKernels::lcd_drive(wanted[s], previous_linear[s], previous_code[s], held) gives them, and the frame stores
 // previous_code / previous_linear replaced as FixedDecoderCore::emit replaces them (held: the eye's first frame,

@@ -87,7 +87,7 @@ void FixedKernels::gaussian_vertical_row(const Raw* const* rows, const Polyphase
     std::array<std::uint32_t, kMaxLineTaps> narrow{};
     for (std::size_t j = 0; j < count; ++j) narrow[j] = static_cast<std::uint32_t>(taps.weight[j]);
     lines::gaussian_rows(rows, narrow.data(), count, static_cast<std::size_t>(samples),
-                         line_plans_.gaussian->vertical_shift, out);
+                         line_plans_.gaussian->vertical_shift, line_plans_.gaussian->fold_rows, out);
     return;
   }
   const int shift = config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits;

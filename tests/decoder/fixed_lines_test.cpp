@@ -317,22 +317,36 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
   }
   std::vector<const std::int64_t*> row_pointers;
   for (const auto& r : rows) row_pointers.push_back(r.data());
-  std::vector<std::uint16_t> expected_rows(kSamples);
-  for (std::size_t i = 0; i < kSamples; ++i) {
-    std::int64_t acc = 0;
-    for (std::size_t j = 0; j < kTaps; ++j) acc += std::int64_t{row_weight[j]} * rows[j][i];
-    expected_rows[i] = static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd));
-  }
+  // The vertical weights as drawn, and mirrored (w_j = w_{n-1-j}: the folded sum where the caller allows it).
+  std::array<std::uint32_t, kTaps> mirrored_weight = row_weight;
+  for (std::size_t j = 0; j < kTaps / 2; ++j) mirrored_weight[kTaps - 1 - j] = mirrored_weight[j];
+  const auto expected_rows = [&](const std::array<std::uint32_t, kTaps>& w) {
+    std::vector<std::uint16_t> out(kSamples);
+    for (std::size_t i = 0; i < kSamples; ++i) {
+      std::int64_t acc = 0;
+      for (std::size_t j = 0; j < kTaps; ++j) acc += std::int64_t{w[j]} * rows[j][i];
+      out[i] = static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd));
+    }
+    return out;
+  };
   for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
     const TargetMock mock(target);
     std::vector<std::int64_t> columns(kSamples);
     fixed_detail::lines::gaussian_columns(row.data(), kRowSamples, plan, kHorizontalShift, columns.data());
-    std::vector<std::uint16_t> vertical(kSamples);
-    fixed_detail::lines::gaussian_rows(row_pointers.data(), row_weight.data(), kTaps, kSamples, kVerticalShift,
-                                       vertical.data());
     for (std::size_t s = 0; s < kSamples; ++s) {
       ASSERT_EQ(columns[s], expected_columns[s]) << hwy::TargetName(target) << " horizontal sample " << s;
-      ASSERT_EQ(vertical[s], expected_rows[s]) << hwy::TargetName(target) << " vertical sample " << s;
+    }
+    for (const bool fold : {false, true}) {
+      for (const auto* w : {&row_weight, &mirrored_weight}) {
+        const std::vector<std::uint16_t> expected = expected_rows(*w);
+        std::vector<std::uint16_t> vertical(kSamples);
+        fixed_detail::lines::gaussian_rows(row_pointers.data(), w->data(), kTaps, kSamples, kVerticalShift, fold,
+                                           vertical.data());
+        for (std::size_t s = 0; s < kSamples; ++s) {
+          ASSERT_EQ(vertical[s], expected[s]) << hwy::TargetName(target) << " vertical sample " << s
+                                              << (fold ? " fold" : "") << (w == &row_weight ? "" : " mirrored");
+        }
+      }
     }
   }
 }
@@ -346,23 +360,30 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
   constexpr int kHorizontalShift = 8;
   for (const int f : {2, 4}) {
     for (const bool regular : {true, false}) {
+     // Mirrored: every column's weights symmetric (w_t = w_{n-1-t}, the folded sums); else some columns shorter.
+     for (const bool mirrored : {false, true}) {
       fixed_detail::Geometry g;
       g.full = cv::Size(f * kColumns, 1);
       g.reduced = cv::Size(kColumns, 1);
       const int taps_per_column = 4 * f + 1;
       for (int k = 0; k < kColumns; ++k) {
         fixed_detail::PolyphaseTaps taps;
-        const int count = k % 5 == 0 ? taps_per_column - 1 : taps_per_column;
+        const int count = k % 5 == 0 && !mirrored ? taps_per_column - 1 : taps_per_column;
         for (int t = 0; t < count; ++t) {
           taps.index.push_back(std::clamp(f * k - 2 * f + t, 0, g.full.width - 1));
           const auto w = static_cast<std::int64_t>(random() % ((1u << 24) / taps_per_column));
-          taps.weight.push_back(k % 3 == 0 ? w & ~std::int64_t{0x7f} : w);  // multiples of 2^7: exact ties
+          if (mirrored && t > count - 1 - t) {
+            taps.weight.push_back(taps.weight[static_cast<std::size_t>(count - 1 - t)]);
+          } else {
+            taps.weight.push_back(k % 3 == 0 ? w & ~std::int64_t{0x7f} : w);  // multiples of 2^7: exact ties
+          }
         }
         g.gauss_cols.push_back(taps);
       }
       if (!regular) g.gauss_cols[kColumns / 3].index[1] += 1;
       const fixed_detail::GaussianColumnsPlan plan = fixed_detail::gaussian_columns_plan(g);
       ASSERT_EQ(plan.decimation, regular ? static_cast<std::size_t>(f) : 0u) << "f=" << f;
+      ASSERT_EQ(plan.symmetric, regular && mirrored) << "f=" << f;
       const std::size_t row_samples = 3 * static_cast<std::size_t>(g.full.width);
       std::vector<std::uint16_t> row(row_samples);
       for (std::uint16_t& code : row) code = static_cast<std::uint16_t>(random() % 256);
@@ -383,10 +404,12 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
         std::vector<std::int64_t> columns(plan.samples, -1);
         fixed_detail::lines::gaussian_columns(row.data(), row_samples, plan, kHorizontalShift, columns.data());
         for (std::size_t s = 0; s < plan.samples; ++s) {
-          ASSERT_EQ(columns[s], expected[s])
-              << hwy::TargetName(target) << " f=" << f << (regular ? " polyphase" : " gather") << " sample " << s;
+          ASSERT_EQ(columns[s], expected[s]) << hwy::TargetName(target) << " f=" << f
+                                              << (regular ? " polyphase" : " gather") << (mirrored ? " mirrored" : "")
+                                              << " sample " << s;
         }
       }
+     }
     }
   }
 }
