@@ -206,7 +206,15 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
                                                     scratch.shown32.data(), scratch.rho32.data());
     out.tally.clipped += clipped;
     out.tally.counts.beta_clipped += clipped;
-    lines::drive_codes(scratch.shown32.data(), n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+    if (plans.lcd) {
+      // |rho| <= 2^F and |shortfall| <= 2^(F+1) (x_t, x_{t-1} and the ends in [0, 1]): the sum within 32 bits.
+      scratch.shortfall.resize(n);
+      emit_line(out, eye, y, scratch.shown32.data(), scratch.shortfall.data());
+      std::int32_t* rho = scratch.rho32.data();
+      for (std::size_t s = 0; s < n; ++s) rho[s] += static_cast<std::int32_t>(scratch.shortfall[s]);
+    } else {
+      emit_line(out, eye, y, scratch.shown32.data(), nullptr);
+    }
     ResidualTally stored;
     scratch.residual_nonzero = lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
     out.tally.add(stored);
@@ -288,8 +296,7 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
       scratch.shown32.resize(n);
       lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
                                     scratch.shown32.data(), m);
-      lines::drive_codes(scratch.shown32.data(), n, *kernels_.line_plans().drive,
-                         out.frame.drive_codes.ptr<std::uint16_t>(y));
+      emit_line(out, eye, y, scratch.shown32.data(), nullptr);
     } else {
       scratch.shown.resize(n);
       lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
@@ -319,6 +326,21 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
                   previous_needed ? scratch.second.data() + 3 * x : nullptr, residual_row, gate, grey, shown);
   }
   if (whole_line) emit_line(out, eye, y, shown, nullptr);
+}
+
+void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown,
+                                 Raw* shortfall) const {
+  const auto n = 3 * static_cast<std::size_t>(eye.full_size.width);
+  const FixedLinePlans& plans = kernels_.line_plans();
+  if (plans.drive) {
+    lines::drive_codes(shown, n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+    if (shortfall != nullptr) std::fill_n(shortfall, n, Raw{0});
+    return;
+  }
+  out.tally.counts.lcd_unreachable += lines::lcd_drive(
+      shown, n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
+      eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
+      shortfall);
 }
 
 void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown, Raw* shortfall) const {

@@ -277,11 +277,16 @@ class FixedDecoderCore {
   // The same on a 32-bit line (the OLED line kernels').
   void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, std::int32_t* out,
                 ColumnBlendCache& cache) const;
-  // The OLED line kernels keep a line in 32-bit words (FixedLinePlans::code_rom32) where the drive search has its
-  // 32-bit tables.
+  // The line kernels keep a line in 32-bit words (FixedLinePlans::code_rom32): an OLED's where the drive search has
+  // its 32-bit tables, an LCD's where its drive kernel runs.
   bool narrow_lines(const FrameOutput& out) const {
-    return line_kernels(out) && !kernels_.line_plans().drive->base32.empty();
+    const FixedLinePlans& plans = kernels_.line_plans();
+    if (!line_values(out) || plans.code_rom32.empty()) return false;
+    return plans.drive ? !plans.drive->base32.empty() : plans.lcd.has_value();
   }
+  // The drive codes of output line y from its shown values on a 32-bit line (narrow_lines): the OLED drive kernel,
+  // or the LCD's, whose shortfall (where not null) a full frame adds to rho.
+  void emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown, Raw* shortfall) const;
   // The line kernels take a whole line, the OLED drive included: no report planes or taps (emit's other work).
   bool line_kernels(const FrameOutput& out) const { return line_values(out) && kernels_.line_plans().drive; }
   // A reduced-frame line's shown values over the whole line, emitted afterwards (emit_line): any panel.

@@ -871,9 +871,10 @@ inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const Fix
   return sample.code;
 }
 
-std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
-                       std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
-                       std::int64_t* shortfall) {
+template <typename Wanted>
+std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                         std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                         std::int64_t* shortfall) {
   std::uint64_t unreachable = 0;
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
@@ -905,6 +906,14 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   const std::int64_t* ends = p.ends.data();
   const bool contributed_stored = p.contributed;
   const LcdIndexShape shape(p);
+  // x_t from a line of either width (FixedLinePlans::code_rom32 says why 32 bits hold it).
+  const auto load_wanted = [&](std::size_t i) {
+    if constexpr (sizeof(Wanted) == 8) {
+      return hn::LoadU(d, wanted + i);
+    } else {
+      return hn::PromoteTo(d, hn::LoadU(d32, wanted + i));
+    }
+  };
   // The eye's first frame takes the pixel as held at x_t (FixedKernels::lcd_drive): x_{t-1} = x_t, and v_{t-1} is
   // found from the held row.
   const auto previous_of = [&](std::size_t i, const auto x) {
@@ -959,7 +968,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
   };
   if (p.index.empty()) {  // the binary search of the merge table's row
     for (; s + lanes <= n; s += lanes) {
-      const auto x = hn::LoadU(d, wanted + s);
+      const auto x = load_wanted(s);
       const auto x_previous = previous_of(s, x);
       const auto sum = hn::Add(x, x_previous);
       const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target_of(sum)), scale));
@@ -981,7 +990,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
     while (s + lanes <= n) {
       const std::size_t m = pass_chunk(n - s, lanes);
       for (std::size_t i = 0; i < m; i += lanes) {  // m's ROM places, then its words
-        const auto x = hn::LoadU(d, wanted + s + i);
+        const auto x = load_wanted(s + i);
         const RomPlace place = target_place(hn::Add(x, previous_of(s + i, x)));
         hn::Store(place.node, d, targets + i);
         hn::Store(place.weight, d, rom_weights + i);
@@ -989,7 +998,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
       }
       look_up(target_packed, targets, m);
       for (std::size_t i = 0; i < m; i += lanes) {
-        const auto x = hn::LoadU(d, wanted + s + i);
+        const auto x = load_wanted(s + i);
         const auto target = target_from(hn::Add(x, previous_of(s + i, x)), hn::Load(d, targets + i),
                                         hn::Load(d, rom_weights + i), hn::Load(d, rom_shifts + i));
         hn::Store(target, d, targets + i);
@@ -1006,7 +1015,7 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
         look_up(index, words, m);
       }
       for (std::size_t i = 0; i < m; i += lanes) {
-        const auto x = hn::LoadU(d, wanted + s + i);
+        const auto x = load_wanted(s + i);
         const auto x_previous = previous_of(s + i, x);
         const auto j = held ? hn::Load(d, held_codes + i) : previous_row(s + i);
         finish(s + i, x, x_previous, hn::Add(x, x_previous), j,
@@ -1022,6 +1031,17 @@ std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan&
                           shortfall != nullptr ? shortfall + s : nullptr, unreachable);
   }
   return unreachable;
+}
+
+std::uint64_t LcdDrive(const std::int64_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                       std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                       std::int64_t* shortfall) {
+  return LcdDriveOf(wanted, n, p, kernels, previous_code, previous_linear, held, codes, shortfall);
+}
+std::uint64_t LcdDrive32(const std::int32_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                         std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                         std::int64_t* shortfall) {
+  return LcdDriveOf(wanted, n, p, kernels, previous_code, previous_linear, held, codes, shortfall);
 }
 
 // The motion weight of one pixel and Eq. 4 of one sample by the stage functions (tails and out-of-lane operands).
@@ -1863,6 +1883,7 @@ HWY_EXPORT(DriveCodes32);
 HWY_EXPORT(Compensate32);
 HWY_EXPORT(AddWeightedResidualsInto32);
 HWY_EXPORT(StoreResiduals32);
+HWY_EXPORT(LcdDrive32);
 
 // Each step on 64-bit lines, then (where the decoder has one) its overload on 32-bit lines.
 void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
@@ -1907,6 +1928,12 @@ std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan
                         std::int64_t* shortfall) {
   return HWY_DYNAMIC_DISPATCH(LcdDrive)(wanted, n, plan, kernels, previous_code, previous_linear, held, codes,
                                         shortfall);
+}
+std::uint64_t lcd_drive(const std::int32_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                        std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                        std::int64_t* shortfall) {
+  return HWY_DYNAMIC_DISPATCH(LcdDrive32)(wanted, n, plan, kernels, previous_code, previous_linear, held, codes,
+                                          shortfall);
 }
 void motion_weights(const std::int64_t* previous, const std::int64_t* alpha, std::size_t pixels, const MotionPlan& plan,
                     const FixedKernels& kernels, std::int64_t* weight, MotionTally& tally) {

@@ -294,6 +294,9 @@ std::uint64_t compensate(const std::uint16_t* codes, const std::int32_t* low, st
                          const FixedLinePlans& plans, std::int32_t* shown, std::int32_t* rho);
 bool store_residuals(const std::int32_t* rho, std::size_t n, const FixedKernels& kernels, std::int32_t* stored,
                      ResidualTally& tally);
+std::uint64_t lcd_drive(const std::int32_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                        std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
+                        std::int64_t* shortfall);
 void add_weighted_residuals(const std::int64_t* alpha, const std::int64_t* weight, const std::int32_t* residual,
                             std::size_t n, const MotionPlan& plan, const FixedKernels& kernels, std::int32_t* shown,
                             MotionTally& tally);

@@ -721,20 +721,25 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
     ASSERT_FALSE(plan->index.empty()) << "the per-row index is built";
     fixed_detail::LcdPlan binary = *plan;  // the binary search of the merge table, where no index is built
     binary.index.clear();
+    const std::vector<std::int32_t> wanted32(wanted.begin(), wanted.end());  // the 32-bit line (narrow_lines)
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+     for (const bool narrow : {false, true}) {
       for (const fixed_detail::LcdPlan* searched : {&*plan, static_cast<const fixed_detail::LcdPlan*>(&binary)}) {
         const TargetMock mock(target);
         const std::string where = std::string(hwy::TargetName(target)) +
                                   (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
                                   std::to_string(linear_frac_bits) + (held ? " held" : "") +
-                                  (searched == &binary ? " binary search" : " index");
+                                  (searched == &binary ? " binary search" : " index") +
+                                  (narrow ? " 32-bit line" : " 64-bit line");
         std::vector<std::uint8_t> store_code(previous_code);
         std::vector<std::uint16_t> codes(kSamples);
         std::vector<std::int32_t> store_linear(previous_linear);
         std::vector<std::int64_t> shortfall(kSamples);
-        const std::uint64_t unreachable = fixed_detail::lines::lcd_drive(
-            wanted.data(), kSamples, *searched, kernels, store_code.data(), store_linear.data(), held, codes.data(),
-            shortfall.data());
+        const std::uint64_t unreachable =
+            narrow ? fixed_detail::lines::lcd_drive(wanted32.data(), kSamples, *searched, kernels, store_code.data(),
+                                                    store_linear.data(), held, codes.data(), shortfall.data())
+                   : fixed_detail::lines::lcd_drive(wanted.data(), kSamples, *searched, kernels, store_code.data(),
+                                                    store_linear.data(), held, codes.data(), shortfall.data());
         EXPECT_EQ(unreachable, expected_unreachable) << where;
         for (std::size_t s = 0; s < kSamples; ++s) {
           ASSERT_EQ(codes[s], expected_codes[s]) << where << " sample " << s << " wanted " << wanted[s];
@@ -743,6 +748,7 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
           ASSERT_EQ(store_linear[s], expected_store_linear[s]) << where << " sample " << s;
         }
       }
+     }
     }
   }
 }
