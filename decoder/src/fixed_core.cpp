@@ -206,17 +206,19 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
                                                     scratch.shown32.data(), scratch.rho32.data());
     out.tally.clipped += clipped;
     out.tally.counts.beta_clipped += clipped;
+    ResidualTally stored;
     if (plans.lcd) {
-      // |rho| <= 2^F and |shortfall| <= 2^(F+1) (x_t, x_{t-1} and the ends in [0, 1]): the sum within 32 bits.
+      // rho plus the shortfall in 64 bits: with the contributed history x_{t-1} may leave [0, 1], and the shortfall
+      // with it (the residual store saturates what leaves its format).
       scratch.shortfall.resize(n);
       emit_line(out, eye, y, scratch.shown32.data(), scratch.shortfall.data());
-      std::int32_t* rho = scratch.rho32.data();
-      for (std::size_t s = 0; s < n; ++s) rho[s] += static_cast<std::int32_t>(scratch.shortfall[s]);
+      Raw* rho = scratch.shortfall.data();
+      for (std::size_t s = 0; s < n; ++s) rho[s] += scratch.rho32[s];
+      scratch.residual_nonzero = lines::store_residuals(rho, n, kernels_, residual_row, stored);
     } else {
       emit_line(out, eye, y, scratch.shown32.data(), nullptr);
+      scratch.residual_nonzero = lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
     }
-    ResidualTally stored;
-    scratch.residual_nonzero = lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
     out.tally.add(stored);
     return;
   }

@@ -125,12 +125,13 @@ struct LineScratch {
   std::vector<Raw> shown;        // the line's emitted linear values
   std::vector<Raw> rho;          // a full frame's beta - shown
   std::vector<Raw> weight;       // a reduced frame's motion weight w per pixel
-  std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho)
+  std::vector<Raw> shortfall;    // an LCD full frame's unreachable drive shortfall (joins rho: on a 32-bit line, rho
+                                 // plus the shortfall here, in 64 bits)
   std::vector<std::int32_t> zero_residual;  // the residual of a line the store holds all zero (DESIGN §7 skip)
   // Whether the last full line's stored residual has a sample that is not 0, where its store kernel said so.
   std::optional<bool> residual_nonzero;
-  // The OLED line kernels' lines in 32-bit words (FixedLinePlans::code_rom32): a full line's L_t, shown and rho, a
-  // reduced line's shown.
+  // The line kernels' lines in 32-bit words (FixedLinePlans::code_rom32, narrow_lines): a full line's L_t, shown and
+  // rho, a reduced line's shown.
   std::vector<std::int32_t> first32;
   std::vector<std::int32_t> shown32;
   std::vector<std::int32_t> rho32;
@@ -274,7 +275,7 @@ class FixedDecoderCore {
   // and the cache where the plans allow, else FixedKernels::upsample_line.
   void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, Raw* out, bool grey,
                 ColumnBlendCache& cache) const;
-  // The same on a 32-bit line (the OLED line kernels').
+  // The same on a 32-bit line (narrow_lines).
   void upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, std::int32_t* out,
                 ColumnBlendCache& cache) const;
   // The line kernels keep a line in 32-bit words (FixedLinePlans::code_rom32): an OLED's where the drive search has

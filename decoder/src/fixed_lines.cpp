@@ -1316,11 +1316,12 @@ std::size_t AddWeightedResidualsNarrow([[maybe_unused]] const std::int64_t* alph
   const hn::RebindToUnsigned<decltype(d64)> du64;
   const std::size_t lanes = hn::Lanes(d);
   const std::size_t pixels_read = lanes / 2;  // one vector of 64-bit weights
-  // The pixels of `lanes` samples span up to (lanes + 1) / 3 + 1 of them: within one weight vector from 8 lanes on.
-  if (lanes < 8 || !p.narrow_weighted_sum) return 0;
+  // The pixels of `lanes` samples span at most (lanes + 1) / 3 + 1 of them: within one weight vector from 4 lanes on.
+  if (lanes < 4 || !p.narrow_weighted_sum) return 0;
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, static_cast<std::int32_t>(p.one));
-  const auto one_u = hn::BitCast(du, one);
+  // A 64-bit value in [0, 1] has its lower 32-bit half at most one and its upper half 0.
+  const auto half_limit = hn::OddEven(zero, one);
   const auto magnitude_limit = hn::Set(du, p.residual_magnitude_limit);
   const int residual_frac_bits = p.residual_frac_bits;
   const int odd_shift = 32 - residual_frac_bits;
@@ -1343,14 +1344,15 @@ std::size_t AddWeightedResidualsNarrow([[maybe_unused]] const std::int64_t* alph
     const auto weights = hn::BitCast(d, hn::LoadU(d64, weight + s / 3));
     const auto alpha_low = hn::LoadU(d64, alpha + s);
     const auto alpha_high = hn::LoadU(d64, alpha + s + pixels_read);
-    // Every 32-bit half of the weights and alphas at most one: each in [0, 1] (a negative value's upper half is all
-    // ones, a value of 2^32 or more has a non-zero upper half).
+    // The weights and alphas in [0, 1]: every lower half at most one and every upper half 0, read unsigned (a
+    // negative value's upper half is all ones).
     const auto largest = hn::Max(hn::BitCast(du, weights),
                                  hn::Max(hn::BitCast(du, alpha_low), hn::BitCast(du, alpha_high)));
+    const auto limit = hn::BitCast(du, half_limit);
     // |rho| read unsigned (|INT32_MIN| = 2^31 too), within the residual format's 2^(width - 1).
     const auto rho = hn::LoadU(d, residual + s);
     const auto magnitude = hn::BitCast(du, hn::Abs(rho));
-    if (!hn::AllTrue(du, hn::And(hn::Eq(hn::Max(largest, one_u), one_u),
+    if (!hn::AllTrue(du, hn::And(hn::Eq(hn::Max(largest, limit), limit),
                                  hn::Eq(hn::Max(magnitude, magnitude_limit), magnitude_limit)))) {
       for (std::size_t i = 0; i < lanes; ++i) {
         shown[s + i] = static_cast<std::int32_t>(
@@ -1507,8 +1509,9 @@ std::optional<MotionPlan> motion_plan(const FixedKernels& kernels, const std::ar
   m.exp_input_frac_bits = c.exp_input_frac_bits;
   m.exponent_shift = c.sensitivity_frac_bits + F - c.exp_input_frac_bits;
   m.residual_frac_bits = c.residual.frac_bits;
-  // |rho| <= 2^(width - 1), so |w rho| rounded to F fraction bits is at most 2^(F + int_bits - 1) + 1, and alpha +
-  // w rho with alpha in [0, 2^F] stays within 32 bits where that is at most 2^29.
+  // |rho| <= 2^(width - 1) = 2^(int_bits + R - 1) and w <= 2^F, so w rho rounded to F fraction bits is at most
+  // 2^(F + int_bits - 1) in magnitude, and alpha + w rho with alpha in [0, 2^F] stays within 32 bits where
+  // F + int_bits <= 30.
   m.narrow_weighted_sum = F + c.residual.int_bits <= 30 && m.residual_frac_bits <= 32;
   m.residual_magnitude_limit = std::uint32_t{1} << (c.residual.width() - 1);
   const auto below32 = [](std::int64_t v) { return v >= 0 && v < (std::int64_t{1} << 32); };

@@ -221,9 +221,10 @@ struct FixedLinePlans {
   std::vector<std::int64_t> code_rom;  // I = lin(E) per link code
   std::int64_t one = 0;
   // code_rom in 32 bits. FixedDecoderConfig bounds F to 28, so a line's linear values (uQ1.F), beta in [-2^F,
-  // 2^(F+1)], rho and alpha' all fit 32 bits, and the OLED's line kernels keep their lines in 32-bit words (the
-  // overloads below on std::int32_t lines): twice the lanes where the arithmetic is 32-bit (Eq. 2 and the split, the
-  // drive codes' input) and half the line traffic elsewhere.
+  // 2^(F+1)], rho and alpha' all fit 32 bits, and the line kernels keep their lines in 32-bit words (the overloads
+  // below on std::int32_t lines; an LCD's rho plus its drive shortfall is added in 64 bits): twice the lanes where
+  // the arithmetic is 32-bit (Eq. 2 and the split, Eq. 4, the drive codes' input) and half the line traffic
+  // elsewhere.
   std::vector<std::int32_t> code_rom32;
 
   static FixedLinePlans build(const FixedKernels& kernels);

@@ -205,6 +205,71 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
   }
 }
 
+// Eq. 4 over a line with operands its 32-bit lanes must not take (MotionPlan::narrow_weighted_sum): alpha and w
+// outside [0, 1] (-1, one + 1, 2^32 and 2^32 + k, whose lower halves lie in [0, 1]) and residuals at and past the
+// format's magnitude 2^(width - 1), beside random in-range ones, against the stage function sample by sample, both
+// line widths, every instruction set.
+TEST(FixedLines, WeightedResidualsTakeTheStageFunctionsOutsideTheirLanes) {
+  const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive");
+  const fixed_detail::FixedKernels kernels(config);
+  const auto& plan = kernels.line_plans().motion;
+  ASSERT_TRUE(plan.has_value() && plan->narrow_weighted_sum);
+  const std::int64_t one = kernels.one();
+  const std::int64_t limit = std::int64_t{1} << (config.residual.width() - 1);
+  const std::int64_t two_to_32 = std::int64_t{1} << 32;
+  constexpr std::size_t kPixels = 61;  // tails after every vector width
+  constexpr std::size_t kSamples = 3 * kPixels;
+  std::mt19937_64 random(29);
+  std::uniform_int_distribution<std::int64_t> linear(0, one);
+  std::uniform_int_distribution<std::int64_t> in_format(-limit, limit - 1);
+  std::vector<std::int64_t> alpha(kSamples), weight(kPixels);
+  std::vector<std::int32_t> residual(kSamples);
+  for (std::size_t s = 0; s < kSamples; ++s) {
+    alpha[s] = linear(random);
+    residual[s] = static_cast<std::int32_t>(in_format(random));
+  }
+  for (std::int64_t& w : weight) w = linear(random);
+  for (const auto& [at, value] : {std::pair{5, two_to_32 + 5}, {20, -1}, {33, one + 1}, {50, two_to_32}, {140, one}}) {
+    alpha[static_cast<std::size_t>(at)] = value;
+  }
+  for (const auto& [at, value] : {std::pair{8, std::int64_t{-1}}, {14, one + 1}, {22, two_to_32}, {30, two_to_32 + 1},
+                                  {40, one}, {41, 0}}) {
+    weight[static_cast<std::size_t>(at)] = value;
+  }
+  for (const auto& [at, value] : {std::pair{70, limit}, {90, limit + 1}, {100, -limit}, {110, -limit - 1},
+                                  {120, std::int64_t{INT32_MIN}}, {121, std::int64_t{INT32_MAX}}}) {
+    residual[static_cast<std::size_t>(at)] = static_cast<std::int32_t>(value);
+  }
+  std::vector<std::int64_t> expected(kSamples);
+  fixed_detail::MotionTally expected_tally;
+  for (std::size_t s = 0; s < kSamples; ++s) {
+    const fixed_detail::WeightedSample w = kernels.add_weighted_residual(alpha[s], weight[s / 3], residual[s]);
+    expected[s] = w.alpha_prime;
+    expected_tally.clipped += w.clipped ? 1 : 0;
+    expected_tally.dropped_sum += w.dropped;
+    const std::int64_t magnitude = residual[s] < 0 ? -std::int64_t{residual[s]} : residual[s];
+    expected_tally.residual_abs_sum += magnitude;
+    expected_tally.residual_abs_max = std::max(expected_tally.residual_abs_max, magnitude);
+  }
+  const auto check = [&](auto shown_word, const std::string& where) {
+    std::vector<decltype(shown_word)> shown(kSamples);
+    fixed_detail::MotionTally tally;
+    fixed_detail::lines::add_weighted_residuals(alpha.data(), weight.data(), residual.data(), kSamples, *plan, kernels,
+                                                shown.data(), tally);
+    for (std::size_t s = 0; s < kSamples; ++s) ASSERT_EQ(shown[s], expected[s]) << where << " sample " << s;
+    EXPECT_EQ(tally.clipped, expected_tally.clipped) << where;
+    EXPECT_EQ(tally.dropped_sum, expected_tally.dropped_sum) << where;
+    EXPECT_EQ(tally.residual_abs_sum, expected_tally.residual_abs_sum) << where;
+    EXPECT_EQ(tally.residual_abs_max, expected_tally.residual_abs_max) << where;
+  };
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    const TargetMock mock(target);
+    check(std::int64_t{0}, std::string(hwy::TargetName(target)) + " 64-bit line");
+    check(std::int32_t{0}, std::string(hwy::TargetName(target)) + " 32-bit line");
+    if (HasFatalFailure()) return;
+  }
+}
+
 // The residual store over a line against FixedKernels::store_residual sample by sample, at the default residual
 // format and at a narrow one (sQ1.6) where rho both rounds and saturates; runs of zeros as long as a vector and
 // isolated non-zero samples, on every instruction set.
@@ -347,6 +412,23 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
                                               << (fold ? " fold" : "") << (w == &row_weight ? "" : " mirrored");
         }
       }
+    }
+    // Mirrored weights over values near 2^32, whose pairs leave a 32-bit operand: the caller does not allow the fold
+    // there, and the kernel must not sum them.
+    std::vector<std::vector<std::int64_t>> wide_rows(kTaps, std::vector<std::int64_t>(kSamples));
+    std::vector<const std::int64_t*> wide_pointers;
+    for (auto& r : wide_rows) {
+      for (std::int64_t& v : r) v = (std::int64_t{1} << 32) - 1 - static_cast<std::int64_t>(random() % 4096);
+      wide_pointers.push_back(r.data());
+    }
+    std::vector<std::uint16_t> wide(kSamples);
+    fixed_detail::lines::gaussian_rows(wide_pointers.data(), mirrored_weight.data(), kTaps, kSamples, kVerticalShift,
+                                       false, wide.data());
+    for (std::size_t i = 0; i < kSamples; ++i) {
+      std::int64_t acc = 0;
+      for (std::size_t j = 0; j < kTaps; ++j) acc += std::int64_t{mirrored_weight[j]} * wide_rows[j][i];
+      ASSERT_EQ(wide[i], static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd)))
+          << hwy::TargetName(target) << " vertical sample " << i << " near 2^32, no fold";
     }
   }
 }

@@ -119,55 +119,74 @@ TEST(FixedSkip, BitIdenticalInTheLinearResampleSpaceAndAt10Bits) {
 // FixedDecoderConfig::motion_weight_statistics = false: lines with no residual to weight skip the motion test too.
 // Against the same decoder with the statistics: the same codes, planes and statistics but the mean weight (NaN
 // where a line skipped) and the underflow count (of the lines tested); the skipped lines are the static ones and
-// those without a residual. Both schedules, both line paths (report planes on and off), one and two threads.
+// those without a residual. Both schedules, both line paths (report planes on and off), one and two threads; at
+// s = 255 the moving lines without a residual underflow Eq. 6, so the underflow count shows that the test did not
+// run there.
 TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
   const EncoderConfig link = link_config(0.5, 0, true);
   const std::vector<LinkFrame> frames = encode_sequence(scene_images("discs", 64, 48, 8), link);
-  for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
-    for (const bool planes : {false, true}) {
-      for (const int threads : {1, 2}) {
-        FixedDecoderConfig with_statistics = fixed_config(link, panel);
-        with_statistics.report_planes = planes;
-        with_statistics.threads = threads;
-        FixedDecoderConfig without = with_statistics;
-        without.motion_weight_statistics = false;
-        FixedStreamingDecoder measured(with_statistics);
-        FixedStreamingDecoder streaming(without);
-        FixedFrameDecoder frame(without);
-        std::uint64_t extra_lines = 0;
-        for (const LinkFrame& f : frames) {
-          const std::string where = panel + (planes ? " planes" : " codes") + " threads=" + std::to_string(threads) +
-                                    " t=" + std::to_string(f.meta.index) + " eye=" + std::to_string(f.meta.eye);
-          const DecodedFrame a = measured.decode(f);
-          const DecodedFrame b = streaming.decode(f);
-          const DecodedFrame c = frame.decode(f);
-          expect_identical_outputs(b, streaming.last_counts(), c, frame.last_counts(), where + " schedules");
-          expect_skip_counts_equal(streaming.last_counts(), frame.last_counts(), where + " schedules");
-          ASSERT_TRUE(test::identical(a.drive_codes, b.drive_codes)) << where;
-          ASSERT_TRUE(test::identical(a.wanted_linear, b.wanted_linear)) << where;
-          EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
-          EXPECT_EQ(a.stats.dropped_sum, b.stats.dropped_sum) << where;
-          EXPECT_EQ(a.stats.residual_mean_abs, b.stats.residual_mean_abs) << where;
-          EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
-          const FixedStageCounts& on = measured.last_counts();
-          const FixedStageCounts& off = streaming.last_counts();
-          EXPECT_EQ(on.alpha_clipped, off.alpha_clipped) << where;
-          EXPECT_EQ(on.residual_read_lines_skipped, off.residual_read_lines_skipped) << where;
-          // Static lines or lines without a residual: at least either set, at most both.
-          EXPECT_GE(off.motion_test_lines_skipped, std::max(on.motion_test_lines_skipped, off.residual_read_lines_skipped)) << where;
-          EXPECT_LE(off.motion_test_lines_skipped, on.motion_test_lines_skipped + off.residual_read_lines_skipped) << where;
-          const std::uint64_t extra = off.motion_test_lines_skipped - on.motion_test_lines_skipped;
-          extra_lines += extra;
-          if (extra > 0) {
-            EXPECT_TRUE(std::isnan(b.stats.mean_motion_weight)) << where;
-            EXPECT_LE(off.weight_underflow, on.weight_underflow) << where;
-          } else {
-            EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
-            EXPECT_EQ(on.weight_underflow, off.weight_underflow) << where;
+  for (const double sensitivity : {10.0, 255.0}) {
+    for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
+      for (const bool planes : {false, true}) {
+        for (const int threads : {1, 2}) {
+          FixedDecoderConfig with_statistics = fixed_config(link, panel);
+          with_statistics.decoder.sensitivity = sensitivity;
+          with_statistics.report_planes = planes;
+          with_statistics.threads = threads;
+          FixedDecoderConfig without = with_statistics;
+          without.motion_weight_statistics = false;
+          FixedStreamingDecoder measured(with_statistics);
+          FixedStreamingDecoder streaming(without);
+          FixedFrameDecoder frame(without);
+          std::uint64_t extra_lines = 0;
+          std::uint64_t fewer_underflows = 0;  // frames whose skipped lines held underflowing pixels
+          for (const LinkFrame& f : frames) {
+            const std::string where = panel + (planes ? " planes" : " codes") + " threads=" + std::to_string(threads) +
+                                      " s=" + std::to_string(sensitivity) + " t=" + std::to_string(f.meta.index) +
+                                      " eye=" + std::to_string(f.meta.eye);
+            const DecodedFrame a = measured.decode(f);
+            const DecodedFrame b = streaming.decode(f);
+            const DecodedFrame c = frame.decode(f);
+            expect_identical_outputs(b, streaming.last_counts(), c, frame.last_counts(), where + " schedules");
+            expect_skip_counts_equal(streaming.last_counts(), frame.last_counts(), where + " schedules");
+            ASSERT_TRUE(test::identical(a.drive_codes, b.drive_codes)) << where;
+            ASSERT_TRUE(test::identical(a.wanted_linear, b.wanted_linear)) << where;
+            ASSERT_TRUE(test::identical(a.drive, b.drive)) << where;
+            ASSERT_TRUE(test::identical(a.emitted_linear, b.emitted_linear)) << where;
+            EXPECT_EQ(a.stats.lcd_unreachable_fraction, b.stats.lcd_unreachable_fraction) << where;
+            EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
+            EXPECT_EQ(a.stats.dropped_sum, b.stats.dropped_sum) << where;
+            EXPECT_EQ(a.stats.residual_mean_abs, b.stats.residual_mean_abs) << where;
+            EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
+            const FixedStageCounts& on = measured.last_counts();
+            const FixedStageCounts& off = streaming.last_counts();
+            EXPECT_EQ(on.alpha_clipped, off.alpha_clipped) << where;
+            EXPECT_EQ(on.lcd_unreachable, off.lcd_unreachable) << where;
+            EXPECT_EQ(on.residual_read_lines_skipped, off.residual_read_lines_skipped) << where;
+            // Static lines or lines without a residual: at least either set, at most both.
+            EXPECT_GE(off.motion_test_lines_skipped,
+                      std::max(on.motion_test_lines_skipped, off.residual_read_lines_skipped))
+                << where;
+            EXPECT_LE(off.motion_test_lines_skipped,
+                      on.motion_test_lines_skipped + off.residual_read_lines_skipped)
+                << where;
+            const std::uint64_t extra = off.motion_test_lines_skipped - on.motion_test_lines_skipped;
+            extra_lines += extra;
+            if (extra > 0) {
+              EXPECT_TRUE(std::isnan(b.stats.mean_motion_weight)) << where;
+              EXPECT_LE(off.weight_underflow, on.weight_underflow) << where;
+              fewer_underflows += off.weight_underflow < on.weight_underflow ? 1 : 0;
+            } else {
+              EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
+              EXPECT_EQ(on.weight_underflow, off.weight_underflow) << where;
+            }
+            if (HasFatalFailure()) return;
           }
-          if (HasFatalFailure()) return;
+          EXPECT_GT(extra_lines, 0u) << panel << " the scene has moving lines without a residual";
+          if (sensitivity == 255.0) {
+            EXPECT_GT(fewer_underflows, 0u) << panel << " the skipped lines' pixels were not tested";
+          }
         }
-        EXPECT_GT(extra_lines, 0u) << panel << " the scene has moving lines without a residual";
       }
     }
   }
@@ -182,7 +201,9 @@ TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
     const DecodedFrame b = reference_run.decode(f, reference_taps);
     expect_identical_outputs(a, tapped.last_counts(), b, reference_run.last_counts(), "taps");
     expect_skip_counts_equal(tapped.last_counts(), reference_run.last_counts(), "taps");
-    for (std::size_t s = 0; s < taps.planes.size(); ++s) EXPECT_EQ(taps.planes[s].values, reference_taps.planes[s].values);
+    for (std::size_t s = 0; s < taps.planes.size(); ++s) {
+      EXPECT_EQ(taps.planes[s].values, reference_taps.planes[s].values);
+    }
   }
 }
 

@@ -65,6 +65,14 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
       for (const nlohmann::json& s : d["repeat_seconds"]) expect_positive(s, name + " repeat");
       ASSERT_EQ(d["repeat_first_pair_seconds"].size(), 2u) << name;
       for (const nlohmann::json& s : d["repeat_first_pair_seconds"]) expect_positive(s, name + " first pair");
+      // The drive codes alone skip the report-only motion tests; the decoders with report planes keep them.
+      if (name == "fixed" || name == "fixed-1t") {
+        EXPECT_EQ(d["motion_weight_statistics"], false) << name;
+      } else if (name == "fixed+planes" || name == "fixed-frame") {
+        EXPECT_EQ(d["motion_weight_statistics"], true) << name;
+      } else {
+        EXPECT_TRUE(d["motion_weight_statistics"].is_null()) << name;
+      }
     }
     EXPECT_EQ(names, (std::set<std::string>{"fixed", "fixed-1t", "fixed+planes", "fixed-frame", "reference",
                                               "opencv-float32"}));

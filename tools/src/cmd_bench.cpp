@@ -30,6 +30,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -196,6 +197,8 @@ struct Contender {
                                     // machine; the machine's other processes are not in it)
   double peak_rss_mib = 0.0;
   double rss_before_mib = 0.0;
+  // A fixed-point decoder's FixedDecoderConfig::motion_weight_statistics (the JSON's null for the others).
+  std::optional<bool> motion_weight_statistics;
 };
 
 FixedDecoderConfig config_for(const BenchSize& size, const std::string& panel, const std::vector<std::string>& formats) {
@@ -296,7 +299,9 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                             std::shared_ptr<HeadsetDecoder> d = make_decoder(impl, c);
                             return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
                           },
-                          {}, {}, {}, 0.0, 0.0});
+                          {}, {}, {}, 0.0, 0.0,
+                          std::string(impl) == "reference" ? std::nullopt
+                                                           : std::optional<bool>(c.motion_weight_statistics)});
   };
   if (banded.threads > 1) add("fixed", "fixed", banded);
   add(banded.threads > 1 ? "fixed-1t" : "fixed", "fixed", codes_only);
@@ -308,7 +313,7 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                           auto d = std::make_shared<bench::OpencvTrmDecoder>(config.decoder);
                           return std::function<void(const LinkFrame&)>([d](const LinkFrame& f) { d->decode(f); });
                         },
-                        {}, {}, {}, 0.0, 0.0});
+                        {}, {}, {}, 0.0, 0.0, std::nullopt});
   const int repeats = options.repeats;
   // The views of the first frame pair (both eyes of each link frame).
   const std::size_t first_pair_views = std::min(views.size(), std::size_t{size.stereo ? 4u : 2u});
@@ -365,6 +370,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
     for (double hz : kRates) realtime[std::to_string(static_cast<int>(hz))] = mpix_per_s * 1e6 / (frame_pixels * hz);
     decoders.push_back({{"name", c.name},
                         {"threads", c.threads},
+                        {"motion_weight_statistics", c.motion_weight_statistics ? Json(*c.motion_weight_statistics)
+                                                                                : Json(nullptr)},
                         {"mpix_per_s", mpix_per_s},
                         {"ms_per_frame", ms_per_frame},
                         {"cpu_ms_per_frame", 1e3 * median(c.cpu_seconds) / link_frames},
@@ -451,8 +458,7 @@ void register_bench(CLI::App& app, Action& action) {
       Json report = {{"machine", {{"hardware_threads", std::thread::hardware_concurrency()},
                                   {"load_average_at_start", {load[0], load[1], load[2]}}}},
                      {"parameters", {{"reduction", 0.5}, {"scene", o.scene}, {"pairs", o.pairs},
-                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats},
-                                     {"fixed_motion_weight_statistics", kFixedMotionWeightStatistics}}}};
+                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats}}}};
       Json results = Json::array();
       std::cout << "trm bench: " << std::thread::hardware_concurrency() << " hardware threads, load average "
                 << load[0] << " at start; OpenCV threads " << cv::getNumThreads() << "\n";

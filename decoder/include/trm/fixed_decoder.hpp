@@ -164,8 +164,10 @@ struct FixedDecoderConfig {
   // residual is all zero (the residual skip above) w weighs nothing, alpha' = clamp(alpha), and the motion test
   // runs only for these statistics. false skips it there, with U of d_{t-1} and its reads, as a controller without
   // these counters would (counted in motion_test_lines_skipped); the codes are the same bits, the frame's
-  // mean_motion_weight is then NaN (not measured) where a line skipped it, and weight_underflow counts the lines
-  // whose motion test ran. No effect with skip_unneeded false or with stage taps (test vectors record w everywhere).
+  // mean_motion_weight is then NaN (not measured) where a line skipped it, weight_underflow counts the lines
+  // whose motion test ran, and grey_lines may count more lines (a skipped line's chroma skip no longer depends on
+  // the d_{t-1} rows it does not read). No effect with skip_unneeded false or with stage taps (test vectors record w
+  // everywhere).
   // What a rig feed or a throughput run needs.
   bool motion_weight_statistics = true;
   // FixedStreamingDecoder::decode of a whole view: bands of output lines on this many threads, each band with its
