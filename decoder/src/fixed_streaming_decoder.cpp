@@ -16,6 +16,7 @@
 #include "line_ring.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <limits>
 #include <memory>
@@ -145,6 +146,8 @@ struct RowBand {
 // The bands of a view: equal shares of the output rows, none shorter than kMinBandRows (a band re-reads the
 // Gaussian's support above it, so short bands waste work).
 constexpr int kMinBandRows = 64;
+// Bands per thread of a whole view (FixedStreamingDecoder::decode_in_bands).
+constexpr int kBandsPerThread = 4;
 
 std::vector<RowBand> row_bands(const Geometry& g, int threads) {
   const int count = std::max(1, std::min(threads, g.full.height / kMinBandRows));
@@ -585,29 +588,31 @@ DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::
 DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
   try {
     view_->open_whole();
+    const fixed_detail::Geometry& g =
+        core_->kernels().geometry(cv::Size(frame.meta.full_width, frame.meta.full_height));
+    const std::size_t threads = fixed_detail::row_bands(g, core_->config().threads).size();
+    // More bands than threads, each taken by the next thread free: a thread held up by other work on its core (a
+    // feed's reading and sending) leaves the rest of the view to the others instead of keeping them waiting.
     const std::vector<fixed_detail::RowBand> bands =
-        fixed_detail::row_bands(core_->kernels().geometry(cv::Size(frame.meta.full_width, frame.meta.full_height)),
-                                core_->config().threads);
+        fixed_detail::row_bands(g, core_->config().threads * fixed_detail::kBandsPerThread);
     std::vector<std::unique_ptr<fixed_detail::StreamingView>> others;
     for (std::size_t b = 1; b < bands.size(); ++b) others.push_back(view_->band_view(bands[b]));
     view_->limit_to(bands.front());
     std::vector<std::exception_ptr> failed(bands.size());
+    std::atomic<std::size_t> next_band{0};
+    const auto run_bands = [&] {
+      for (std::size_t b; (b = next_band.fetch_add(1, std::memory_order_relaxed)) < bands.size();) {
+        try {
+          (b == 0 ? *view_ : *others[b - 1]).run_band(frame.codes);
+        } catch (...) {
+          failed[b] = std::current_exception();
+        }
+      }
+    };
     {
       std::vector<std::jthread> workers;
-      for (std::size_t b = 0; b < others.size(); ++b) {
-        workers.emplace_back([&, b] {
-          try {
-            others[b]->run_band(frame.codes);
-          } catch (...) {
-            failed[b + 1] = std::current_exception();
-          }
-        });
-      }
-      try {
-        view_->run_band(frame.codes);
-      } catch (...) {
-        failed[0] = std::current_exception();
-      }
+      for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(run_bands);
+      run_bands();
     }  // joined
     for (const std::exception_ptr& e : failed) {
       if (e) std::rethrow_exception(e);

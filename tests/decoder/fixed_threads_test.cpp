@@ -109,6 +109,19 @@ TEST(FixedThreads, ViewsWithLostLinesAndLostViewsMatchOnePipeline) {
   }
 }
 
+// A tall view is cut into more bands than threads (four per thread, each taken by the next thread free): 96 x 640 is
+// 8 bands on 2 threads and 10 on 3, in whatever order the threads take them, with the same bits as one pipeline.
+TEST(FixedThreads, MoreBandsThanThreadsGiveTheOnePipelineBits) {
+  for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5, 0, true), panel);
+    config.report_planes = false;  // the line kernels' path, as a feed runs it
+    config.motion_weight_statistics = false;
+    expect_bands_identical(encode_sequence(scene_images("discs", kWidth, 640, 4), link_config(0.5, 0, true)), config,
+                           "tall discs " + panel);
+    if (HasFatalFailure()) return;
+  }
+}
+
 TEST(FixedThreads, ShortViewsRunOnFewerThreadsAndCountsOutOfRangeAreRejected) {
   FixedStreamingDecoder decoder(with_threads(fixed_config(link_config(0.5)), 8));
   EXPECT_EQ(decoder.threads_for(cv::Size(64, 63)), 1);
