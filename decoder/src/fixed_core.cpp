@@ -61,7 +61,8 @@ cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type) {
   return plane;
 }
 
-FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye) const {
+FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye, bool codes_checked) const {
+  if (codes_checked) eye.last_output = DecodedFrame();  // replaced by this view's output at finish
   FrameOutput out;
   const cv::Size full(meta.full_width, meta.full_height);
   out.frame.meta = meta;
@@ -264,7 +265,8 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
   const bool motion_static = gate != nullptr && gate->motion_static;
   const bool residual_zero = gate != nullptr && gate->residual_zero;
   const bool weight_unused = gate != nullptr && gate->weight_unused;
-  const bool previous_needed = (residual_row != nullptr || residual_zero) && (gate == nullptr || gate->reads_previous());
+  const bool previous_needed =
+      (residual_row != nullptr || residual_zero) && (gate == nullptr || gate->reads_previous());
   // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line (an
   // LCD's one sample after the other, as emit takes them: a reduced frame passes on no shortfall).
   const bool whole_line = line_values(out);

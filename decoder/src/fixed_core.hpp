@@ -170,7 +170,11 @@ class FixedDecoderCore {
   // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
   DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
   // The output matrices at full size: planes of an earlier view of the eye that no caller holds any more, else new.
-  FrameOutput start_output(const FrameMeta& meta, EyeState& eye) const;
+  // codes_checked: every code of the view has passed its range check before its first line, so that only an
+  // internal failure can stop it: the held output (read only for a lost view) then gives up its planes to it, and
+  // the eye holds one output plane where the caller keeps none (a failed view leaves the eye no held output, and a
+  // lost view after it black).
+  FrameOutput start_output(const FrameMeta& meta, EyeState& eye, bool codes_checked) const;
   // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
   Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;
   // Prepares the LCD frame stores of the eye for this frame (first frame: held history).

@@ -113,7 +113,7 @@ DecodedFrame FixedFrameDecoder::decode_impl(const LinkFrame& received, FixedStag
   const LinkFrame frame = lost != nullptr ? LinkFrame{received.meta, detail::concealed_codes(received.codes, *lost)}
                                           : received;
   const Geometry& g = core_->kernels().geometry(eye.full_size);
-  fixed_detail::FrameOutput out = core_->start_output(frame.meta, eye);
+  fixed_detail::FrameOutput out = core_->start_output(frame.meta, eye, true);  // begin checked every code
   out.full = frame.meta.parity == Parity::Full;
   out.concealed_lines = lost != nullptr ? lost->lost_lines : 0;
   core_->begin_lcd(out, eye);

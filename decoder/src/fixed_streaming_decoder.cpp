@@ -20,6 +20,7 @@
 #include <exception>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -211,8 +212,9 @@ class StreamingView {
     input(line, codes);
   }
 
-  // A whole view decoded in bands: this view takes the first band, `band_view` builds the others over the same
-  // frame stores and output, run_band computes a band from the whole view's codes, absorb joins a band's tally.
+  // A whole view decoded in bands: `band_view` builds a band's view over the same frame stores and output (with its
+  // own line buffers and an empty line scratch), run_band computes a band from the whole view's codes, add_tally_to
+  // and absorb join the bands' tallies into this view, which runs none.
   void open_whole() {
     start(0);
     std::fill(intact_.begin(), intact_.end(), std::uint8_t{1});
@@ -220,6 +222,7 @@ class StreamingView {
   std::unique_ptr<StreamingView> band_view(const RowBand& band) const {
     auto view = std::unique_ptr<StreamingView>(new StreamingView(*this));
     view->out_.tally = FrameTally();
+    view->scratch_ = LineScratch();  // line working memory, sized at first use
     view->limit_to(band);
     return view;
   }
@@ -245,8 +248,11 @@ class StreamingView {
       input(line, codes.ptr<std::uint16_t>(line));
     }
   }
-  void absorb(const StreamingView& band) { out_.tally += band.out_.tally; }
+  void add_tally_to(FrameTally& total) const { total += out_.tally; }
+  void absorb(const FrameTally& bands) { out_.tally += bands; }
   void mark_all_pushed() { pushed_ = meta_.height; }
+  // Before the first line: the whole view's codes have passed their range check (decode, not push_line).
+  void mark_codes_checked() { codes_checked_ = true; }
 
   DecodedFrame finish() {
     if (!started_) return core_.decode_lost(meta_, kWho);
@@ -285,7 +291,7 @@ class StreamingView {
     const Geometry& g = *g_;
     const StreamPlan plan = plan_for(g);
     full_ = meta_.parity == Parity::Full;
-    out_ = core_.start_output(meta_, eye);
+    out_ = core_.start_output(meta_, eye, codes_checked_);
     out_.full = full_;
     core_.begin_lcd(out_, eye);
     const int full_samples = 3 * g.full.width;
@@ -418,6 +424,7 @@ class StreamingView {
   int pushed_ = 0;
   int lost_lines_ = 0;
   bool started_ = false;  // the first intact line has arrived
+  bool codes_checked_ = false;  // every code checked before the first line (FixedDecoderCore::start_output)
   int first_ = 0;         // lines above it are read as it (see source_line)
   bool full_ = false;
   EyeState* eye_ = nullptr;
@@ -578,6 +585,7 @@ DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::
   const bool whole = std::all_of(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
   detail::check_link_frame(frame, core_->config().decoder.link, kWho, whole ? core_->config().threads : 1);
   begin_view(frame.meta);
+  view_->mark_codes_checked();
   if (whole && core_->config().threads > 1) return decode_in_bands(frame);
   for (int y = 0; y < frame.codes.rows; ++y) {
     take_line(frame.codes.ptr<std::uint16_t>(y), line_intact.empty() || line_intact[static_cast<std::size_t>(y)] != 0);
@@ -595,15 +603,19 @@ DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
     // feed's reading and sending) leaves the rest of the view to the others instead of keeping them waiting.
     const std::vector<fixed_detail::RowBand> bands =
         fixed_detail::row_bands(g, core_->config().threads * fixed_detail::kBandsPerThread);
-    std::vector<std::unique_ptr<fixed_detail::StreamingView>> others;
-    for (std::size_t b = 1; b < bands.size(); ++b) others.push_back(view_->band_view(bands[b]));
-    view_->limit_to(bands.front());
+    // Each band's view is built when a thread takes the band, as a copy of this view, which runs none and so keeps
+    // the state every band starts from, and let go when its tally is in: as many band views at a time as threads.
     std::vector<std::exception_ptr> failed(bands.size());
     std::atomic<std::size_t> next_band{0};
+    std::mutex tally_mutex;
+    fixed_detail::FrameTally bands_tally;
     const auto run_bands = [&] {
       for (std::size_t b; (b = next_band.fetch_add(1, std::memory_order_relaxed)) < bands.size();) {
         try {
-          (b == 0 ? *view_ : *others[b - 1]).run_band(frame.codes);
+          const std::unique_ptr<fixed_detail::StreamingView> band = view_->band_view(bands[b]);
+          band->run_band(frame.codes);
+          const std::lock_guard lock(tally_mutex);
+          band->add_tally_to(bands_tally);
         } catch (...) {
           failed[b] = std::current_exception();
         }
@@ -617,7 +629,7 @@ DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
     for (const std::exception_ptr& e : failed) {
       if (e) std::rethrow_exception(e);
     }
-    for (const auto& band : others) view_->absorb(*band);
+    view_->absorb(bands_tally);
     view_->mark_all_pushed();
   } catch (...) {
     view_.reset();

@@ -2,7 +2,9 @@
 // hardware line buffer is built.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -11,30 +13,53 @@
 namespace trm::fixed_detail {
 
 // `depth` circular lines of `samples` values; input line n lives in slot n mod depth. Reading a line that was
-// overwritten (or never written) is a scheduling bug and throws.
+// overwritten (or never written) is a scheduling bug and throws. The lines are not initialised, and a copy copies only
+// the lines written: a buffer that holds none (a view's whole-view template, FixedStreamingDecoder::decode_in_bands)
+// touches no memory until its lines are written.
 template <typename T>
 class LineRing {
  public:
   LineRing(std::string name, int depth, int samples)
-      : name_(std::move(name)), samples_(samples), data_(static_cast<std::size_t>(depth) * samples), tags_(static_cast<std::size_t>(depth), -1) {}
+      : name_(std::move(name)),
+        samples_(static_cast<std::size_t>(samples)),
+        data_(std::make_unique_for_overwrite<T[]>(static_cast<std::size_t>(depth) * samples_)),
+        tags_(static_cast<std::size_t>(depth), -1) {}
+  LineRing(const LineRing& other)
+      : name_(other.name_),
+        samples_(other.samples_),
+        data_(std::make_unique_for_overwrite<T[]>(other.tags_.size() * other.samples_)),
+        tags_(other.tags_) {
+    for (std::size_t slot = 0; slot < tags_.size(); ++slot) {
+      if (tags_[slot] < 0) continue;
+      const T* line = other.data_.get() + slot * samples_;
+      std::copy(line, line + samples_, data_.get() + slot * samples_);
+    }
+  }
+  LineRing& operator=(const LineRing& other) {
+    if (this != &other) *this = LineRing(other);
+    return *this;
+  }
+  LineRing(LineRing&&) noexcept = default;
+  LineRing& operator=(LineRing&&) noexcept = default;
+  ~LineRing() = default;
 
   T* write(int line) {
     const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
     tags_[slot] = line;
-    return data_.data() + slot * static_cast<std::size_t>(samples_);
+    return data_.get() + slot * samples_;
   }
   const T* read(int line) const {
     const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
     if (tags_[slot] != line) {
       throw std::logic_error("line buffer '" + name_ + "': line " + std::to_string(line) + " is not held");
     }
-    return data_.data() + slot * static_cast<std::size_t>(samples_);
+    return data_.get() + slot * samples_;
   }
 
  private:
   std::string name_;
-  int samples_;
-  std::vector<T> data_;
+  std::size_t samples_;
+  std::unique_ptr<T[]> data_;
   std::vector<int> tags_;
 };
 

@@ -133,6 +133,38 @@ TEST(FixedConcealment, FollowsTheReferenceRules) {
   EXPECT_THROW(fresh.decode(full, std::vector<std::uint8_t>(5, 1)), std::invalid_argument);
 }
 
+// The held output (what a lost view shows) gives its plane to the next checked view of its eye where no caller keeps
+// it: one output plane per eye in steady state. A plane a caller keeps is never written; a view rejected by its
+// range check leaves the held output as it was; a lost view shows the last view's codes in either case.
+TEST(FixedConcealment, TheHeldOutputGivesItsPlaneToTheNextViewAndSurvivesARejectedOne) {
+  const EncoderConfig link = link_config(0.5);
+  const TrmEncoder encoder(link);
+  const std::vector<cv::Mat> images = test::scene_images("discs", 64, 48, 6);
+  for (const bool streaming : {true, false}) {
+    FixedDecoderConfig config = fixed_config(link);
+    config.report_planes = false;
+    std::unique_ptr<HeadsetDecoder> decoder;
+    if (streaming) decoder = std::make_unique<FixedStreamingDecoder>(config);
+    else decoder = std::make_unique<FixedFrameDecoder>(config);
+    const std::string what = streaming ? "streaming" : "frame";
+    const std::uint8_t* first_plane = decoder->decode(encoder.encode(images[0], 0)).drive_codes.data;
+    const std::uint8_t* second_plane = decoder->decode(encoder.encode(images[1], 1)).drive_codes.data;
+    EXPECT_EQ(second_plane, first_plane) << what << ": the released plane is the next view's";
+    const DecodedFrame kept = decoder->decode(encoder.encode(images[2], 2));
+    const cv::Mat kept_codes = kept.drive_codes.clone();
+    const DecodedFrame next = decoder->decode(encoder.encode(images[3], 3));
+    EXPECT_NE(next.drive_codes.data, kept.drive_codes.data) << what << ": a kept plane is not written";
+    EXPECT_EQ(cv::norm(kept.drive_codes, kept_codes, cv::NORM_INF), 0.0) << what;
+    // A view with a code past the link's depth is rejected before any work: the held output is view 3's.
+    LinkFrame bad = encoder.encode(images[4], 4);
+    bad.codes.at<std::uint16_t>(5, 7) = 4096;
+    EXPECT_THROW(decoder->decode(bad), std::invalid_argument) << what;
+    const DecodedFrame lost = decoder->decode_lost(encoder.encode(images[4], 4).meta);
+    EXPECT_TRUE(lost.stats.frame_lost) << what;
+    EXPECT_EQ(cv::norm(lost.drive_codes, next.drive_codes, cv::NORM_INF), 0.0) << what << ": the held output";
+  }
+}
+
 TEST(FixedConcealment, AgreesWithReferenceUnderFaultsOled) {
   for (double r : {1.0, 0.5, 0.4}) {
     for (bool stereo : {false, true}) {
