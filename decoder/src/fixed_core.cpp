@@ -332,36 +332,37 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
   if (whole_line) emit_line(out, eye, y, shown, nullptr);
 }
 
-void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown,
-                                 Raw* shortfall) const {
+namespace {
+
+// The drive codes of output line y by the OLED or the LCD drive kernel, from a line of either width; false where the
+// plans have neither.
+template <typename Linear>
+bool drive_line(const FixedKernels& kernels, FrameOutput& out, EyeState& eye, int y, const Linear* shown,
+                Raw* shortfall) {
   const auto n = 3 * static_cast<std::size_t>(eye.full_size.width);
-  const FixedLinePlans& plans = kernels_.line_plans();
+  const FixedLinePlans& plans = kernels.line_plans();
   if (plans.drive) {
     lines::drive_codes(shown, n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
     if (shortfall != nullptr) std::fill_n(shortfall, n, Raw{0});
-    return;
+    return true;
   }
+  if (!plans.lcd) return false;
   out.tally.counts.lcd_unreachable += lines::lcd_drive(
-      shown, n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
+      shown, n, *plans.lcd, kernels, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
       eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
       shortfall);
+  return true;
+}
+
+}  // namespace
+
+void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown,
+                                 Raw* shortfall) const {
+  drive_line(kernels_, out, eye, y, shown, shortfall);  // narrow_lines: one of the kernels runs
 }
 
 void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown, Raw* shortfall) const {
-  const auto n = 3 * static_cast<std::size_t>(eye.full_size.width);
-  const FixedLinePlans& plans = kernels_.line_plans();
-  if (plans.drive) {
-    lines::drive_codes(shown, n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
-    if (shortfall != nullptr) std::fill_n(shortfall, n, Raw{0});
-    return;
-  }
-  if (plans.lcd) {
-    out.tally.counts.lcd_unreachable += lines::lcd_drive(
-        shown, n, *plans.lcd, kernels_, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
-        eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
-        shortfall);
-    return;
-  }
+  if (drive_line(kernels_, out, eye, y, shown, shortfall)) return;
   for (int x = 0; x < eye.full_size.width; ++x) {
     for (int ch = 0; ch < 3; ++ch) {
       const Raw missing = emit(out, eye, y, x, ch, shown[3 * x + ch]);

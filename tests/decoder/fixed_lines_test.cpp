@@ -117,6 +117,25 @@ TEST(FixedLines, KernelsGiveThePerSampleBitsOnEveryInstructionSet) {
   }
 }
 
+// Eq. 4 of every sample by the stage function (sample s weighted by pixel s / 3's w), and what it adds to a tally.
+std::vector<std::int64_t> weighted_by_stage_function(const fixed_detail::FixedKernels& kernels,
+                                                     const std::vector<std::int64_t>& alpha,
+                                                     const std::vector<std::int64_t>& weight,
+                                                     const std::vector<std::int32_t>& residual,
+                                                     fixed_detail::MotionTally& tally) {
+  std::vector<std::int64_t> shown(alpha.size());
+  for (std::size_t s = 0; s < alpha.size(); ++s) {
+    const fixed_detail::WeightedSample w = kernels.add_weighted_residual(alpha[s], weight[s / 3], residual[s]);
+    shown[s] = w.alpha_prime;
+    tally.clipped += w.clipped ? 1 : 0;
+    tally.dropped_sum += w.dropped;
+    const std::int64_t magnitude = residual[s] < 0 ? -std::int64_t{residual[s]} : residual[s];
+    tally.residual_abs_sum += magnitude;
+    tally.residual_abs_max = std::max(tally.residual_abs_max, magnitude);
+  }
+  return shown;
+}
+
 // The motion kernels (Eqs. 4-6 over a line) against the stage functions, operand by operand: random linear values in
 // [0, 1], equal pairs (c = 0), black, the top value, sums of a few LSB (whose contrast shift leaves the lanes), values
 // outside [0, 1] (the stage functions' pixels), on every instruction set, at three sensitivities (s = 255 underflows
@@ -165,15 +184,7 @@ TEST(FixedLines, MotionKernelsGiveTheStageFunctionsBitsOperandByOperand) {
       expected.underflow += underflow ? 1 : 0;
       expected.weight_sum += expected_weight[x];
     }
-    for (std::size_t s = 0; s < 3 * kPixels; ++s) {
-      const fixed_detail::WeightedSample w = kernels.add_weighted_residual(alpha[s], expected_weight[s / 3], residual[s]);
-      expected_shown[s] = w.alpha_prime;
-      expected.clipped += w.clipped ? 1 : 0;
-      expected.dropped_sum += w.dropped;
-      const std::int64_t magnitude = residual[s] < 0 ? -std::int64_t{residual[s]} : residual[s];
-      expected.residual_abs_sum += magnitude;
-      expected.residual_abs_max = std::max(expected.residual_abs_max, magnitude);
-    }
+    expected_shown = weighted_by_stage_function(kernels, alpha, expected_weight, residual, expected);
     EXPECT_GT(expected.clipped, 0u) << "the operands reach Eq. 4's clamp";
     if (sensitivity == 255.0) {
       EXPECT_GT(expected.underflow, 0u) << "the operands reach Eq. 6's underflow";
@@ -240,17 +251,9 @@ TEST(FixedLines, WeightedResidualsTakeTheStageFunctionsOutsideTheirLanes) {
                                   {120, std::int64_t{INT32_MIN}}, {121, std::int64_t{INT32_MAX}}}) {
     residual[static_cast<std::size_t>(at)] = static_cast<std::int32_t>(value);
   }
-  std::vector<std::int64_t> expected(kSamples);
   fixed_detail::MotionTally expected_tally;
-  for (std::size_t s = 0; s < kSamples; ++s) {
-    const fixed_detail::WeightedSample w = kernels.add_weighted_residual(alpha[s], weight[s / 3], residual[s]);
-    expected[s] = w.alpha_prime;
-    expected_tally.clipped += w.clipped ? 1 : 0;
-    expected_tally.dropped_sum += w.dropped;
-    const std::int64_t magnitude = residual[s] < 0 ? -std::int64_t{residual[s]} : residual[s];
-    expected_tally.residual_abs_sum += magnitude;
-    expected_tally.residual_abs_max = std::max(expected_tally.residual_abs_max, magnitude);
-  }
+  const std::vector<std::int64_t> expected =
+      weighted_by_stage_function(kernels, alpha, weight, residual, expected_tally);
   const auto check = [&](auto shown_word, const std::string& where) {
     std::vector<decltype(shown_word)> shown(kSamples);
     fixed_detail::MotionTally tally;
