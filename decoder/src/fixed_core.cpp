@@ -3,6 +3,7 @@
 #include "fixed_core.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -34,8 +35,14 @@ EyeState& FixedDecoderCore::begin(const FrameMeta& meta) {
 
 namespace {
 
+// How many hold a plane's data. Read with acquire order: a caller lets a view go on a thread of its own (trm feed's
+// sending thread), and its last reads of the plane must come before a reuse writes it.
+int owners(const cv::Mat& m) {
+  return m.u == nullptr ? 0 : std::atomic_ref<int>(m.u->refcount).load(std::memory_order_acquire);
+}
+
 // Held by its owner alone (the spare list): no returned frame, held output or concealment shares it.
-bool unshared(const cv::Mat& m) { return m.u != nullptr && m.u->refcount == 1; }
+bool unshared(const cv::Mat& m) { return owners(m) == 1; }
 
 }  // namespace
 
@@ -62,18 +69,27 @@ cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type) {
 }
 
 FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye, bool codes_checked) const {
-  if (codes_checked) eye.last_output = DecodedFrame();  // replaced by this view's output at finish
   FrameOutput out;
   const cv::Size full(meta.full_width, meta.full_height);
   out.frame.meta = meta;
   out.frame.meta.width = full.width;
   out.frame.meta.height = full.height;
   const bool planes = config().report_planes;
+  // A spare plane is free where the spare list alone holds it, or, for a view whose codes were all checked, the held
+  // output (read only for a lost view) besides: that view then takes the held output's planes, and the held output
+  // is let go for them (finish holds this view's instead), so that an eye keeps one output where no caller keeps any.
+  const DecodedFrame& held = eye.last_output;
+  const auto free_plane = [&](const cv::Mat& plane, const cv::Mat& held_plane) {
+    return plane.u != nullptr && owners(plane) == (codes_checked && plane.u == held_plane.u ? 2 : 1);
+  };
   // A spare with report planes where they are wanted (and none where not: the held output keeps the codes only).
-  const auto fits = [planes](const cv::Mat& plane) { return planes ? unshared(plane) : plane.empty(); };
+  const auto fits = [&](const cv::Mat& plane, const cv::Mat& held_plane) {
+    return planes ? free_plane(plane, held_plane) : plane.empty();
+  };
   for (const DecodedFrame& spare : eye.spare_outputs) {
-    if (unshared(spare.drive_codes) && fits(spare.wanted_linear) && fits(spare.drive) &&
-        fits(spare.emitted_linear)) {
+    if (free_plane(spare.drive_codes, held.drive_codes) && fits(spare.wanted_linear, held.wanted_linear) &&
+        fits(spare.drive, held.drive) && fits(spare.emitted_linear, held.emitted_linear)) {
+      if (spare.drive_codes.u == held.drive_codes.u) eye.last_output = DecodedFrame();
       out.frame.wanted_linear = spare.wanted_linear;
       out.frame.drive = spare.drive;
       out.frame.drive_codes = spare.drive_codes;

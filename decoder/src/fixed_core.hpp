@@ -170,10 +170,10 @@ class FixedDecoderCore {
   // A view that never arrived: this eye's previous output again (black if none); the residual is dropped.
   DecodedFrame decode_lost(const FrameMeta& meta, const char* who);
   // The output matrices at full size: planes of an earlier view of the eye that no caller holds any more, else new.
-  // codes_checked: every code of the view has passed its range check before its first line, so that only an
-  // internal failure can stop it: the held output (read only for a lost view) then gives up its planes to it, and
-  // the eye holds one output plane where the caller keeps none (a failed view leaves the eye no held output, and a
-  // lost view after it black).
+  // codes_checked: every code of the view has passed its range check before its first line (decode; a view pushed
+  // line by line keeps the held output whole until it ends): the held output (read only for a lost view) then gives
+  // its planes to this view where no caller keeps them, so that the eye holds one output plane, and is let go only
+  // then (an internal failure after that leaves the eye no held output, and a lost view after it black).
   FrameOutput start_output(const FrameMeta& meta, EyeState& eye, bool codes_checked) const;
   // Writes one output channel sample from the wanted linear value x (uQ1.F); returns the LCD shortfall (else 0).
   Raw emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const;

@@ -12,10 +12,11 @@
 
 namespace trm::fixed_detail {
 
-// `depth` circular lines of `samples` values; input line n lives in slot n mod depth. Reading a line that was
+// `depth` circular lines of `samples` values; input line n >= 0 lives in slot n mod depth. Reading a line that was
 // overwritten (or never written) is a scheduling bug and throws. The lines are not initialised, and a copy copies only
 // the lines written: a buffer that holds none (a view's whole-view template, FixedStreamingDecoder::decode_in_bands)
-// touches no memory until its lines are written.
+// touches no memory until its lines are written. The sanitizer build (TRM_POISON_LINE_BUFFERS) fills them with a
+// pattern instead, so that a read of memory no line wrote would change the bits the tests compare.
 template <typename T>
 class LineRing {
  public:
@@ -23,14 +24,21 @@ class LineRing {
       : name_(std::move(name)),
         samples_(static_cast<std::size_t>(samples)),
         data_(std::make_unique_for_overwrite<T[]>(static_cast<std::size_t>(depth) * samples_)),
-        tags_(static_cast<std::size_t>(depth), -1) {}
+        tags_(static_cast<std::size_t>(depth), kUnwritten) {
+#ifdef TRM_POISON_LINE_BUFFERS
+    std::fill(data_.get(), data_.get() + tags_.size() * samples_, static_cast<T>(0x5A5A5A5A5A5A5A5AULL));
+#endif
+  }
   LineRing(const LineRing& other)
       : name_(other.name_),
         samples_(other.samples_),
         data_(std::make_unique_for_overwrite<T[]>(other.tags_.size() * other.samples_)),
         tags_(other.tags_) {
+#ifdef TRM_POISON_LINE_BUFFERS
+    std::fill(data_.get(), data_.get() + tags_.size() * samples_, static_cast<T>(0x5A5A5A5A5A5A5A5AULL));
+#endif
     for (std::size_t slot = 0; slot < tags_.size(); ++slot) {
-      if (tags_[slot] < 0) continue;
+      if (tags_[slot] == kUnwritten) continue;
       const T* line = other.data_.get() + slot * samples_;
       std::copy(line, line + samples_, data_.get() + slot * samples_);
     }
@@ -44,19 +52,21 @@ class LineRing {
   ~LineRing() = default;
 
   T* write(int line) {
+    if (line < 0) throw std::logic_error("line buffer '" + name_ + "': line " + std::to_string(line) + " written");
     const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
     tags_[slot] = line;
     return data_.get() + slot * samples_;
   }
   const T* read(int line) const {
     const std::size_t slot = static_cast<std::size_t>(line) % tags_.size();
-    if (tags_[slot] != line) {
+    if (line < 0 || tags_[slot] != line) {
       throw std::logic_error("line buffer '" + name_ + "': line " + std::to_string(line) + " is not held");
     }
     return data_.get() + slot * samples_;
   }
 
  private:
+  static constexpr int kUnwritten = -1;  // no line: line numbers are >= 0
   std::string name_;
   std::size_t samples_;
   std::unique_ptr<T[]> data_;
