@@ -559,7 +559,7 @@ std::uint64_t CompensateOf(const std::uint16_t* codes, const Linear* low, std::s
   HWY_ALIGN Linear full[kPassChunk];
   while (s + lanes <= n) {
     const std::size_t count = pass_chunk(n - s, lanes);
-    for (std::size_t i = 0; i < count; ++i) full[i] = code_rom[codes[s + i]];
+    look_up_into(code_rom, codes + s, count, full);
     for (std::size_t i = 0; i < count; i += lanes) {
       const auto f = hn::Load(d, full + i);
       const auto beta = hn::Sub(hn::Add(f, f), hn::LoadU(d, low + s + i));
@@ -1297,11 +1297,12 @@ void AddWeightedResiduals(const std::int64_t* alpha, const std::int64_t* weight,
   AddWeightedResidualsOf(alpha, weight, residual, n, p, kernels, shown, tally);
 }
 // Eq. 4 into a 32-bit line in 32-bit lanes (MotionPlan::narrow_weighted_sum: alpha, w, rho of the residual format
-// and alpha + w rho all within 32 bits): twice the samples per vector of AddWeightedResidualsOf, where the clamp is AVX2's native 32-bit
-// minimum and maximum. w rho is a 64-bit product of the even lanes and one of the odd lanes; the rounded shift by R
-// keeps bits [R, R + 32) of each, which a logical shift right (even) or left by 32 - R (odd) puts in the lane's
-// 32-bit half, equal to the arithmetic shift's low half for R <= 32. Vectors with an operand outside [0, 1] (w,
-// alpha) or a residual outside its format take the stage functions. Returns the samples done; the caller does the rest.
+// and alpha + w rho all within 32 bits): twice the samples per vector of AddWeightedResidualsOf, where the clamp is
+// AVX2's native 32-bit minimum and maximum. w rho is a 64-bit product of the even lanes and one of the odd lanes; the
+// rounded shift by R keeps bits [R, R + 32) of each, which a logical shift right (even) or left by 32 - R (odd) puts
+// in the lane's 32-bit half, equal to the arithmetic shift's low half for R <= 32. Vectors with an operand outside
+// [0, 1] (w, alpha) or a residual outside its format take the stage functions. Returns the samples done; the caller
+// does the rest.
 std::size_t AddWeightedResidualsNarrow([[maybe_unused]] const std::int64_t* alpha,
                                        [[maybe_unused]] const std::int64_t* weight,
                                        [[maybe_unused]] const std::int32_t* residual, [[maybe_unused]] std::size_t n,
@@ -1327,6 +1328,11 @@ std::size_t AddWeightedResidualsNarrow([[maybe_unused]] const std::int64_t* alph
   const int odd_shift = 32 - residual_frac_bits;
   const auto residual_half = hn::Set(du64, std::uint64_t{1} << (residual_frac_bits - 1));
   const auto low_halves = hn::Set(du64, std::uint64_t{0xFFFFFFFF});
+  // A vector's unsigned 32-bit lanes summed in pairs into 64-bit lanes (sums that 32 bits would overflow).
+  const auto pair_sums = [&](const auto v) {
+    const auto wide = hn::BitCast(du64, v);
+    return hn::Add(hn::And(wide, low_halves), hn::ShiftRight<32>(wide));
+  };
   // Element e: 2 (e / 3), the 32-bit half holding the weight of sample e's pixel in a vector of 64-bit weights.
   static const std::array<std::int32_t, 3 + DrivePlan::kMaxLanes> half_of_pixel = [] {
     std::array<std::int32_t, 3 + DrivePlan::kMaxLanes> t{};
@@ -1372,11 +1378,9 @@ std::size_t AddWeightedResidualsNarrow([[maybe_unused]] const std::int64_t* alph
     const auto clipped = hn::Ne(clamped, sum);
     clipped_lanes = CountInto(d, clipped_lanes, clipped);
     if (!hn::AllFalse(d, clipped)) {  // what the clamp drops, at most 2^30 a sample: summed in 64 bits
-      const auto gap = hn::BitCast(du64, hn::Abs(hn::Sub(sum, clamped)));
-      dropped = hn::Add(dropped, hn::Add(hn::And(gap, low_halves), hn::ShiftRight<32>(gap)));
+      dropped = hn::Add(dropped, pair_sums(hn::Abs(hn::Sub(sum, clamped))));
     }
-    const auto magnitude64 = hn::BitCast(du64, magnitude);
-    magnitude_sum = hn::Add(magnitude_sum, hn::Add(hn::And(magnitude64, low_halves), hn::ShiftRight<32>(magnitude64)));
+    magnitude_sum = hn::Add(magnitude_sum, pair_sums(magnitude));
     magnitude_max = hn::Max(magnitude_max, magnitude);
   }
   tally.clipped += Total(d, clipped_lanes);
