@@ -25,18 +25,14 @@ class LineRing {
         samples_(static_cast<std::size_t>(samples)),
         data_(std::make_unique_for_overwrite<T[]>(static_cast<std::size_t>(depth) * samples_)),
         tags_(static_cast<std::size_t>(depth), kUnwritten) {
-#ifdef TRM_POISON_LINE_BUFFERS
-    std::fill(data_.get(), data_.get() + tags_.size() * samples_, static_cast<T>(0x5A5A5A5A5A5A5A5AULL));
-#endif
+    poison();
   }
   LineRing(const LineRing& other)
       : name_(other.name_),
         samples_(other.samples_),
         data_(std::make_unique_for_overwrite<T[]>(other.tags_.size() * other.samples_)),
         tags_(other.tags_) {
-#ifdef TRM_POISON_LINE_BUFFERS
-    std::fill(data_.get(), data_.get() + tags_.size() * samples_, static_cast<T>(0x5A5A5A5A5A5A5A5AULL));
-#endif
+    poison();
     for (std::size_t slot = 0; slot < tags_.size(); ++slot) {
       if (tags_[slot] == kUnwritten) continue;
       const T* line = other.data_.get() + slot * samples_;
@@ -67,6 +63,12 @@ class LineRing {
 
  private:
   static constexpr int kUnwritten = -1;  // no line: line numbers are >= 0
+
+  void poison() {
+#ifdef TRM_POISON_LINE_BUFFERS
+    std::fill(data_.get(), data_.get() + tags_.size() * samples_, static_cast<T>(0x5A5A5A5A5A5A5A5AULL));
+#endif
+  }
   std::string name_;
   std::size_t samples_;
   std::unique_ptr<T[]> data_;
