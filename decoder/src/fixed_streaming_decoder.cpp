@@ -253,6 +253,9 @@ class StreamingView {
   void mark_all_pushed() { pushed_ = meta_.height; }
   // Before the first line: the whole view's codes have passed their range check (decode, not push_line).
   void mark_codes_checked() { codes_checked_ = true; }
+  // The lines pushed are rows of a whole view that outlives this one (decode, not push_line): the input rings hold
+  // them where they are.
+  void mark_input_in_place() { input_in_place_ = true; }
 
   DecodedFrame finish() {
     if (!started_) return core_.decode_lost(meta_, kWho);
@@ -335,6 +338,8 @@ class StreamingView {
     const int full_samples = 3 * g.full.width;
     if (codes == nullptr) {
       repeat_line(*delay_, y_in, full_samples);
+    } else if (input_in_place_) {
+      delay_->refer(y_in, codes);
     } else {
       std::copy(codes, codes + full_samples, delay_->write(y_in));
     }
@@ -378,7 +383,9 @@ class StreamingView {
 
   void reduced_input(int k, const std::uint16_t* codes) {
     const int reduced_samples = 3 * g_->reduced.width;
-    if (codes != nullptr) {
+    if (codes != nullptr && input_in_place_) {
+      in_lines_->refer(k, codes);
+    } else if (codes != nullptr) {
       std::copy(codes, codes + reduced_samples, in_lines_->write(k));
     } else if (!substitute_.empty()) {
       const std::uint16_t* stored = substitute_.ptr<std::uint16_t>(k);  // d_{t-1} frame store row k
@@ -425,6 +432,7 @@ class StreamingView {
   int lost_lines_ = 0;
   bool started_ = false;  // the first intact line has arrived
   bool codes_checked_ = false;  // every code checked before the first line (FixedDecoderCore::start_output)
+  bool input_in_place_ = false;  // mark_input_in_place
   int first_ = 0;         // lines above it are read as it (see source_line)
   bool full_ = false;
   EyeState* eye_ = nullptr;
@@ -586,6 +594,7 @@ DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::
   detail::check_link_frame(frame, core_->config().decoder.link, kWho, whole ? core_->config().threads : 1);
   begin_view(frame.meta);
   view_->mark_codes_checked();
+  view_->mark_input_in_place();
   if (whole && core_->config().threads > 1) return decode_in_bands(frame);
   for (int y = 0; y < frame.codes.rows; ++y) {
     take_line(frame.codes.ptr<std::uint16_t>(y), line_intact.empty() || line_intact[static_cast<std::size_t>(y)] != 0);
