@@ -290,6 +290,32 @@ void BM_LineBlendRowsEotf(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, std::int32_t)->Arg(0)->Arg(1);
 BENCHMARK_TEMPLATE(BM_LineBlendRowsEotf, Raw)->Arg(0)->Arg(1);
 
+// The exact row blend straight into drive codes (a reduced line whose stored residual is all zero, where nothing reads
+// w): what replaces the row blend, Eq. 4 and the drive search there.
+void BM_LineBlendRowsDrive(benchmark::State& state) {
+  FixedKernels kernels(config_of("vive"));
+  const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
+  const auto n = static_cast<std::size_t>(3 * kWidth);
+  std::vector<std::uint32_t> top(n), bottom(n);
+  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 2).data(),
+                                          g.column_blend, n, top.data());
+  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 3).data(),
+                                          g.column_blend, n, bottom.data());
+  std::vector<std::uint16_t> codes(n);
+  for (auto _ : state) {
+    const bool exact = trm::fixed_detail::lines::blend_rows_drive(
+        top.data(), bottom.data(), n, static_cast<std::uint32_t>(g.bilinear_rows[1].upper), g.column_blend.weight_bits,
+        *kernels.line_plans().eotf, kernels.line_plans().drive_of_node, codes.data());
+    if (!exact) {
+      state.SkipWithError("the exact path does not apply");
+      break;
+    }
+    benchmark::DoNotOptimize(codes.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 3 * kWidth);
+}
+BENCHMARK(BM_LineBlendRowsDrive);
+
 // A line of random linear values in [0, limit] in the line kernels' words.
 template <typename Line>
 std::vector<Line> random_line(std::size_t n, Raw limit, unsigned seed) {

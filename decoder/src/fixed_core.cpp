@@ -189,6 +189,19 @@ void blend_line(const std::uint16_t* row0, const std::uint16_t* row1, const Geom
                          g.column_blend.weight_bits, eotf, out);
 }
 
+// The drive codes of output line y straight from U's nodes (lines::blend_rows_drive); false where its exact path does
+// not apply to the row.
+bool blend_line_codes(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
+                      const FixedLinePlans& plans, ColumnBlendCache& cache, std::uint16_t* codes) {
+  const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
+  const std::uint32_t upper = static_cast<std::uint32_t>(row.upper);
+  if (plans.eotf->exact_row_bits(upper, g.column_blend.weight_bits) < 0) return false;
+  const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
+  const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
+  return lines::blend_rows_drive(top, bottom, g.column_blend.upper.size(), upper, g.column_blend.weight_bits,
+                                 *plans.eotf, plans.drive_of_node, codes);
+}
+
 }  // namespace
 
 void FixedDecoderCore::upsample(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
@@ -291,11 +304,19 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     // Eqs. 4-6 over the line: w per pixel (1 on a static line, as reduced_pixel takes it), then alpha'. A line whose
     // stored residual is all zero takes the same kernels over zeros: w rho = 0 leaves clamp(alpha), what
     // clamp_alpha gives, and w still counts towards the mean-weight statistic.
+    const auto pixels = static_cast<std::size_t>(g.full.width);
+    const FixedLinePlans& plans = kernels_.line_plans();
+    // Where nothing reads w, such a line's alpha' is alpha itself (every U node lies in [0, 1] where the composed
+    // table is built: the clamp is never taken and Eq. 4 adds nothing to the tally), so its codes are U's nodes'.
+    if (residual_zero && !previous_needed && plans.drive && !plans.drive_of_node.empty() &&
+        blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, out.frame.drive_codes.ptr<std::uint16_t>(y))) {
+      if (motion_static) out.tally.weight_sum += kernels_.one() * static_cast<Raw>(pixels);
+      return;
+    }
     if (residual_zero) {
       if (scratch.zero_residual.size() != n) scratch.zero_residual.assign(n, 0);
       residual_row = scratch.zero_residual.data();
     }
-    const auto pixels = static_cast<std::size_t>(g.full.width);
     scratch.weight.resize(pixels);
     MotionTally m;
     if (motion_static || weight_unused) {  // (an unused w: any value in [0, 1] gives clamp(alpha) over zeros)

@@ -300,8 +300,8 @@ void BlendRowsEotfExact(const std::uint32_t* top, const std::uint32_t* bottom, s
 template <typename Linear>
 void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                        int column_bits, const EotfPlan& p, Linear* out) {
-  const int row_bits = upper == 0 ? 0 : p.frac_bits - std::countr_zero(upper);
-  if (!p.node32.empty() && upper <= p.unit && column_bits + row_bits <= p.segments_log2) {
+  const int row_bits = p.exact_row_bits(upper, column_bits);
+  if (row_bits >= 0) {
     BlendRowsEotfExact(top, bottom, n, upper, column_bits, row_bits, p, out);
     return;
   }
@@ -345,6 +345,49 @@ void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, st
   for (; s < n; ++s) {
     const std::uint64_t blended = static_cast<std::uint64_t>(p.unit - upper) * top[s] + static_cast<std::uint64_t>(upper) * bottom[s];
     store_linear(eotf_scalar(blended, p), out + s);
+  }
+}
+
+// BlendRowsEotfExact's nodes as drive codes (FixedLinePlans::drive_of_node): node place i of sample s reads word
+// 3 i + s mod 3 of the composed table.
+void BlendRowsDriveExact(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                         int column_bits, int row_bits, const EotfPlan& p, const std::uint16_t* drive_of_node,
+                         std::uint16_t* codes) {
+  const int down = p.frac_bits - column_bits;
+  const std::uint32_t r = upper >> (p.frac_bits - row_bits);
+  const std::uint32_t r_other = (std::uint32_t{1} << row_bits) - r;
+  const int up = p.segments_log2 - column_bits - row_bits;
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::uint32_t> du;
+  const std::size_t lanes = hn::Lanes(du);
+  const auto weight = hn::Set(du, r);
+  const auto other_weight = hn::Set(du, r_other);
+  const auto three = hn::Set(du, 3u);
+  // Element e: e mod 3, the channels of the samples s0.. of a vector from element s0 mod 3.
+  static const std::array<std::uint32_t, 3 + DrivePlan::kMaxLanes> channel_of = [] {
+    std::array<std::uint32_t, 3 + DrivePlan::kMaxLanes> t{};
+    for (std::size_t e = 0; e < t.size(); ++e) t[e] = static_cast<std::uint32_t>(e % 3);
+    return t;
+  }();
+  const std::size_t phase_step = lanes % 3;
+  std::size_t phase = 0;
+  HWY_ALIGN std::uint32_t places[kPassChunk];
+  while (s + lanes <= n) {
+    const std::size_t count = pass_chunk(n - s, lanes);
+    for (std::size_t i = 0; i < count; i += lanes, phase = next_phase(phase, phase_step)) {
+      const auto t = hn::ShiftRightSame(hn::LoadU(du, top + s + i), down);
+      const auto b = hn::ShiftRightSame(hn::LoadU(du, bottom + s + i), down);
+      const auto place = hn::ShiftLeftSame(hn::Add(hn::Mul(other_weight, t), hn::Mul(weight, b)), up);
+      hn::Store(hn::Add(hn::Mul(place, three), hn::LoadU(du, channel_of.data() + phase)), du, places + i);
+    }
+    look_up_into(drive_of_node, places, count, codes + s);
+    s += count;
+  }
+#endif
+  for (; s < n; ++s) {
+    const std::uint32_t place = (r_other * (top[s] >> down) + r * (bottom[s] >> down)) << up;
+    codes[s] = drive_of_node[3 * static_cast<std::size_t>(place) + s % 3];
   }
 }
 
@@ -1643,6 +1686,15 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   if (!kernels.lcd()) {
     plans.drive = drive_plan({&kernels.drive_index(0), &kernels.drive_index(1), &kernels.drive_index(2)});
   }
+  if (plans.drive && plans.eotf && !plans.eotf->node32.empty() && plans.eotf->node32.size() <= (std::size_t{1} << 17)) {
+    const std::vector<std::int32_t>& node = plans.eotf->node32;
+    if (std::all_of(node.begin(), node.end(), [&](std::int32_t v) { return v >= 0 && v <= plans.one; })) {
+      plans.drive_of_node.resize(3 * node.size());
+      for (std::size_t i = 0; i < node.size(); ++i) {
+        for (int ch = 0; ch < 3; ++ch) plans.drive_of_node[3 * i + static_cast<std::size_t>(ch)] = kernels.drive_code(node[i], ch);
+      }
+    }
+  }
   return plans;
 }
 
@@ -1886,6 +1938,7 @@ HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(StoreResiduals);
 HWY_EXPORT(TargetName);
 HWY_EXPORT(BlendRowsEotf32);
+HWY_EXPORT(BlendRowsDriveExact);
 HWY_EXPORT(DriveCodes32);
 HWY_EXPORT(Compensate32);
 HWY_EXPORT(AddWeightedResidualsInto32);
@@ -1903,6 +1956,15 @@ void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std:
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                      int column_weight_bits, const EotfPlan& plan, std::int32_t* out) {
   HWY_DYNAMIC_DISPATCH(BlendRowsEotf32)(top, bottom, n, upper, column_weight_bits, plan, out);
+}
+bool blend_rows_drive(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                      int column_weight_bits, const EotfPlan& plan, const std::vector<std::uint16_t>& drive_of_node,
+                      std::uint16_t* codes) {
+  const int row_bits = plan.exact_row_bits(upper, column_weight_bits);
+  if (row_bits < 0 || drive_of_node.size() != 3 * plan.node32.size()) return false;
+  HWY_DYNAMIC_DISPATCH(BlendRowsDriveExact)(top, bottom, n, upper, column_weight_bits, row_bits, plan,
+                                            drive_of_node.data(), codes);
+  return true;
 }
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(DriveCodes)(linear, n, plan, out);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -68,6 +69,13 @@ struct EotfPlan {
   int frac_bits = 0;                   // W
   int segments_log2 = 0;               // k
   std::vector<std::int32_t> node32;    // node in 32 bits (uQ1.F, F <= 28)
+
+  // q_r for a row weight `upper` after column blends of q_c = column_bits, where the exact path above applies; -1
+  // where it does not.
+  int exact_row_bits(std::uint32_t upper, int column_bits) const {
+    const int row_bits = upper == 0 ? 0 : frac_bits - std::countr_zero(upper);
+    return !node32.empty() && upper <= unit && column_bits + row_bits <= segments_log2 ? row_bits : -1;
+  }
 };
 
 // The OLED drive code search (ThresholdIndex) of the three channels in one table each, for interleaved samples:
@@ -226,6 +234,11 @@ struct FixedLinePlans {
   // the arithmetic is 32-bit (Eq. 2 and the split, Eq. 4, the drive codes' input) and half the line traffic
   // elsewhere.
   std::vector<std::int32_t> code_rom32;
+  // U's exact path composed with the OLED drive (a simulation table; the modelled hardware runs both): [3 i + ch] is
+  // the drive code of eotf->node32[i] on channel ch, which is a sample's code wherever its shown value is its U node
+  // itself (a reduced line whose stored residual is all zero: alpha' = clamp(alpha) = alpha). Built where every node
+  // lies in [0, 1] (so the clamp is never taken) and the table has at most 2^17 nodes; empty otherwise.
+  std::vector<std::uint16_t> drive_of_node;
 
   static FixedLinePlans build(const FixedKernels& kernels);
 };
@@ -246,6 +259,11 @@ void blend_columns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::s
 // are column blends whose weights are multiples of 2^-column_weight_bits (ColumnBlendPlan::weight_bits).
 void blend_rows_eotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                      int column_weight_bits, const EotfPlan& plan, std::int64_t* out);
+// codes[s] = drive_of_node[3 i + s mod 3] for U's node i of sample s (FixedLinePlans::drive_of_node), where U's exact
+// path applies to the row (EotfPlan::exact_row_bits); false, writing nothing, where it does not.
+bool blend_rows_drive(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
+                      int column_weight_bits, const EotfPlan& plan, const std::vector<std::uint16_t>& drive_of_node,
+                      std::uint16_t* codes);
 // out[s] = the drive code of linear[s] (channel s mod 3), as ThresholdIndex::search gives it.
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
 // Eq. 2 and the split (FixedKernels::compensate): beta = 2 lin(codes[s]) - low[s] (lin through plans.code_rom),

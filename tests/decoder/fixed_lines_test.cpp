@@ -691,7 +691,8 @@ TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
 // 64- and 32-bit lines: at r = 1/2 through the exact path (quarter weights: one ROM node per sample), at r = 0.4 and
 // 3/4 through the ROM interpolation, and at r = 1/2 with the exact path refused (a column weight's bits said too
 // many), on every instruction set. Random codes, and the rows of black and of the top code. The tables of the path
-// that must not run are zeroed, so that a sample taking it would fail.
+// that must not run are zeroed, so that a sample taking it would fail. The exact path composed with the OLED drive
+// (blend_rows_drive) against the drive code of each sample's U by the stage function.
 TEST(FixedLines, RowBlendGivesThePerSampleUpsampleOnEveryRow) {
   std::mt19937_64 random(37);
   // 202 pixels at r = 1/2: an exact factor 2, quarter weights; 203: 102 reduced columns, weights of no short fraction.
@@ -740,11 +741,21 @@ TEST(FixedLines, RowBlendGivesThePerSampleUpsampleOnEveryRow) {
         const auto upper = static_cast<std::uint32_t>(row.upper);
         fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n, upper, column_bits, eotf, wide.data());
         fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n, upper, column_bits, eotf, narrow.data());
+        // The exact path's nodes as drive codes (FixedLinePlans::drive_of_node), by the drive's stage function;
+        // refused, writing nothing, where the path does not apply.
+        std::vector<std::uint16_t> codes(n, 0xFFFF);
+        ASSERT_EQ(fixed_detail::lines::blend_rows_drive(top.data(), bottom.data(), n, upper, column_bits, eotf,
+                                                        kernels.line_plans().drive_of_node, codes.data()),
+                  exact)
+            << hwy::TargetName(target) << " r " << r << " row " << y;
         for (std::size_t s = 0; s < n; ++s) {
           ASSERT_EQ(wide[s], expected[s]) << hwy::TargetName(target) << " r " << r << (exact ? " exact" : "")
                                           << " row " << y << " sample " << s << ", 64-bit line";
           ASSERT_EQ(narrow[s], expected[s]) << hwy::TargetName(target) << " r " << r << (exact ? " exact" : "")
                                             << " row " << y << " sample " << s << ", 32-bit line";
+          const std::uint16_t code = exact ? kernels.drive_code(expected[s], static_cast<int>(s % 3)) : 0xFFFF;
+          ASSERT_EQ(codes[s], code) << hwy::TargetName(target) << " r " << r << (exact ? " exact" : "") << " row "
+                                    << y << " sample " << s << ", drive codes";
         }
       }
     }
