@@ -462,8 +462,10 @@ void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, con
     nonzero = any_bits != 0;
   }
   eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
-  // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel).
-  eye.residual_grey[static_cast<std::size_t>(y)] = FixedKernels::grey_line(residual_row, eye.full_size.width) ? 1 : 0;
+  // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel); a line
+  // all zero is grey without a second read.
+  const bool grey = !nonzero || FixedKernels::grey_line(residual_row, eye.full_size.width);
+  eye.residual_grey[static_cast<std::size_t>(y)] = grey ? 1 : 0;
   out.tally.counts.residual_write_lines_skipped += nonzero ? 0 : 1;
 }
 
