@@ -306,12 +306,22 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     // clamp_alpha gives, and w still counts towards the mean-weight statistic.
     const auto pixels = static_cast<std::size_t>(g.full.width);
     const FixedLinePlans& plans = kernels_.line_plans();
-    // Where nothing reads w, such a line's alpha' is alpha itself (every U node lies in [0, 1] where the composed
-    // table is built: the clamp is never taken and Eq. 4 adds nothing to the tally), so its codes are U's nodes'.
-    if (residual_zero && !previous_needed && plans.drive && !plans.drive_of_node.empty() &&
-        blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, out.frame.drive_codes.ptr<std::uint16_t>(y))) {
-      if (motion_static) out.tally.weight_sum += kernels_.one() * static_cast<Raw>(pixels);
-      return;
+    // Where nothing reads w and every U node lies in [0, 1], such a line's alpha' is alpha itself (the clamp is
+    // never taken, and Eq. 4 adds nothing to the tally): on an OLED its codes are U's nodes' where the composed table
+    // applies, else alpha is driven as it is.
+    if (residual_zero && !previous_needed && plans.eotf->within_unit) {
+      const bool coded = plans.drive && !plans.drive_of_node.empty() &&
+                         blend_line_codes(in0, in1, g, y, plans, scratch.first_rows,
+                                          out.frame.drive_codes.ptr<std::uint16_t>(y));
+      if (!coded && narrow_lines(out)) {
+        scratch.first32.resize(n);
+        upsample(in0, in1, g, y, scratch.first32.data(), scratch.first_rows);
+        emit_line(out, eye, y, scratch.first32.data(), nullptr);
+      }
+      if (coded || narrow_lines(out)) {
+        if (motion_static) out.tally.weight_sum += kernels_.one() * static_cast<Raw>(pixels);
+        return;
+      }
     }
     if (residual_zero) {
       if (scratch.zero_residual.size() != n) scratch.zero_residual.assign(n, 0);

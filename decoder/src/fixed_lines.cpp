@@ -1620,6 +1620,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     e.weight_bits = weight_bits;
     e.frac_bits = W;
     e.segments_log2 = c.eotf_segments_per_code_log2;
+    e.within_unit = std::all_of(rom.begin(), rom.end(), [&](std::int64_t v) { return v >= 0 && v <= plans.one; });
     if (std::all_of(rom.begin(), rom.end(), [](std::int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; })) {
       e.node32.assign(rom.begin(), rom.end());
     }
@@ -1686,13 +1687,12 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   if (!kernels.lcd()) {
     plans.drive = drive_plan({&kernels.drive_index(0), &kernels.drive_index(1), &kernels.drive_index(2)});
   }
-  if (plans.drive && plans.eotf && !plans.eotf->node32.empty() && plans.eotf->node32.size() <= (std::size_t{1} << 17)) {
+  if (plans.drive && plans.eotf && plans.eotf->within_unit && !plans.eotf->node32.empty() &&
+      plans.eotf->node32.size() <= (std::size_t{1} << 17)) {
     const std::vector<std::int32_t>& node = plans.eotf->node32;
-    if (std::all_of(node.begin(), node.end(), [&](std::int32_t v) { return v >= 0 && v <= plans.one; })) {
-      plans.drive_of_node.resize(3 * node.size());
-      for (std::size_t i = 0; i < node.size(); ++i) {
-        for (int ch = 0; ch < 3; ++ch) plans.drive_of_node[3 * i + static_cast<std::size_t>(ch)] = kernels.drive_code(node[i], ch);
-      }
+    plans.drive_of_node.resize(3 * node.size());
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      for (int ch = 0; ch < 3; ++ch) plans.drive_of_node[3 * i + static_cast<std::size_t>(ch)] = kernels.drive_code(node[i], ch);
     }
   }
   return plans;

@@ -69,6 +69,9 @@ struct EotfPlan {
   int frac_bits = 0;                   // W
   int segments_log2 = 0;               // k
   std::vector<std::int32_t> node32;    // node in 32 bits (uQ1.F, F <= 28)
+  // Every node in [0, 1]: U's every value is then in [0, 1] (an interpolation lies between two nodes), and Eq. 4's
+  // clamp of alpha alone (a zero residual) is never taken.
+  bool within_unit = false;
 
   // q_r for a row weight `upper` after column blends of q_c = column_bits, where the exact path above applies; -1
   // where it does not.
@@ -237,7 +240,7 @@ struct FixedLinePlans {
   // U's exact path composed with the OLED drive (a simulation table; the modelled hardware runs both): [3 i + ch] is
   // the drive code of eotf->node32[i] on channel ch, which is a sample's code wherever its shown value is its U node
   // itself (a reduced line whose stored residual is all zero: alpha' = clamp(alpha) = alpha). Built where every node
-  // lies in [0, 1] (so the clamp is never taken) and the table has at most 2^17 nodes; empty otherwise.
+  // lies in [0, 1] (EotfPlan::within_unit) and the table has at most 2^17 nodes; empty otherwise.
   std::vector<std::uint16_t> drive_of_node;
 
   static FixedLinePlans build(const FixedKernels& kernels);
