@@ -181,12 +181,14 @@ namespace {
 // the row blend and the EOTF, into a line of either width.
 template <typename Line>
 void blend_line(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y, const EotfPlan& eotf,
-                ColumnBlendCache& cache, Line* out) {
+                ColumnBlendCache& cache, Line* out, std::size_t begin = 0,
+                std::size_t end = std::numeric_limits<std::size_t>::max()) {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
   const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
-  lines::blend_rows_eotf(top, bottom, g.column_blend.upper.size(), static_cast<std::uint32_t>(row.upper),
-                         g.column_blend.weight_bits, eotf, out);
+  end = std::min(end, g.column_blend.upper.size());
+  lines::blend_rows_eotf(top + begin, bottom + begin, end - begin, static_cast<std::uint32_t>(row.upper),
+                         g.column_blend.weight_bits, eotf, out + begin);
 }
 
 // The drive codes of output line y straight from U's nodes (lines::blend_rows_drive); false where its exact path does
@@ -337,7 +339,24 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     // and alpha' into 32-bit words where the OLED's drive search reads them (narrow_lines), else 64-bit ones.
     scratch.first.resize(n);
     upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);
-    if (previous_needed) {
+    if (previous_needed && !config().motion_weight_statistics && skipping()) {
+      // Without the statistics w weighs only where rho is not 0: the motion test, and U of d_{t-1} before it, run on
+      // the runs of kMotionRunPixels pixels that hold such a sample (2 % of the pixels of the panorama capture's
+      // lines with a residual lay in 14 % of its runs); elsewhere w = 1, which over zeros gives clamp(alpha) as any
+      // w would.
+      scratch.second.resize(n);
+      std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
+      for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
+        const std::size_t x1 = std::min(pixels, x0 + kMotionRunPixels);
+        std::int32_t any_bits = 0;
+        for (std::size_t s = 3 * x0; s < 3 * x1; ++s) any_bits |= residual_row[s];
+        if (any_bits == 0) continue;
+        blend_line(prev0, prev1, g, y, *plans.eotf, scratch.second_rows, scratch.second.data(), 3 * x0, 3 * x1);
+        lines::motion_weights(scratch.second.data() + 3 * x0, scratch.first.data() + 3 * x0, x1 - x0, *motion,
+                              kernels_, scratch.weight.data() + x0, m);
+      }
+      ++out.tally.unweighed_lines;  // w of the other runs not measured
+    } else if (previous_needed) {
       scratch.second.resize(n);
       upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
       lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,

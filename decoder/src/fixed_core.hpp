@@ -76,6 +76,10 @@ cv::Mat frame_plane(cv::Size size, int type);
 // A plane of `size` and `type` from `spares` that nothing else holds, else a new frame_plane (kept in `spares`).
 cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type);
 
+// Without FixedDecoderConfig::motion_weight_statistics, a reduced line with a residual runs the motion test on the
+// runs of this many pixels that hold a residual sample that is not 0 (FixedDecoderCore::reduced_line).
+inline constexpr std::size_t kMotionRunPixels = 64;
+
 // The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
 // flags of its U source rows and the full frame's residual line flag.
 struct ReducedLineGate {

@@ -116,15 +116,51 @@ TEST(FixedSkip, BitIdenticalInTheLinearResampleSpaceAndAt10Bits) {
   }
 }
 
-// FixedDecoderConfig::motion_weight_statistics = false: lines with no residual to weight skip the motion test too.
-// Against the same decoder with the statistics: the same codes, planes and statistics but the mean weight (NaN
-// where a line skipped) and the underflow count (of the lines tested); the skipped lines are the static ones and
-// those without a residual. Both schedules, both line paths (report planes on and off), one and two threads; at
-// s = 255 the moving lines without a residual underflow Eq. 6, so the underflow count shows that the test did not
-// run there.
+// Without the motion statistics a line with a residual runs the motion test on the runs of kMotionRunPixels pixels
+// that hold a residual sample that is not 0: a residual at a single column, at the first or last pixel of a run or of
+// the short run at the line's end (150 pixels: runs [0, 64), [64, 128), [128, 150)), must still be weighed. A full
+// frame of grey 0.4 with a white column clips there alone (beta = 2 - L_t > 1, and 2 (0.4) - L_t > 0 beside it); the
+// next reduced frame, grey 0.2, moves (w < 1 at the column). Against the decoder with the statistics, which weighs
+// every pixel.
+TEST(FixedSkip, WithoutMotionStatisticsEveryRunHoldingAResidualIsWeighed) {
+  const EncoderConfig link = link_config(0.5);
+  constexpr int kWidth = 150;
+  for (const int column : {0, 63, 64, 127, 128, 149}) {
+    cv::Mat full(16, kWidth, CV_64FC3, cv::Scalar::all(0.4));
+    full.col(column).setTo(cv::Scalar::all(1.0));
+    const cv::Mat reduced(16, kWidth, CV_64FC3, cv::Scalar::all(0.2));
+    const std::vector<LinkFrame> frames = encode_sequence({full, reduced}, link);
+    ASSERT_EQ(frames.at(1).meta.parity, Parity::Reduced);
+    FixedDecoderConfig with_statistics = fixed_config(link, "vive");
+    with_statistics.report_planes = false;  // the line kernels (the report planes' per-sample path weighs every pixel)
+    FixedDecoderConfig without = with_statistics;
+    without.motion_weight_statistics = false;
+    FixedStreamingDecoder measured(with_statistics);
+    FixedStreamingDecoder streaming(without);
+    for (const LinkFrame& f : frames) {
+      const DecodedFrame a = measured.decode(f);
+      const DecodedFrame b = streaming.decode(f);
+      ASSERT_TRUE(test::identical(a.drive_codes, b.drive_codes)) << "column " << column << " t=" << f.meta.index;
+      if (f.meta.parity == Parity::Full) {
+        ASSERT_GT(a.stats.residual_max_abs, 0.0) << "column " << column << ": the white column clips";
+      } else {
+        EXPECT_LT(a.stats.mean_motion_weight, 1.0) << "column " << column << ": the reduced frame moves";
+        EXPECT_TRUE(std::isnan(b.stats.mean_motion_weight)) << "column " << column << ": runs skipped";
+      }
+    }
+  }
+}
+
+// FixedDecoderConfig::motion_weight_statistics = false: lines with no residual to weight skip the motion test too,
+// and lines with a residual skip it outside the runs of kMotionRunPixels pixels that hold one (150 pixels: runs of
+// 64, 64 and 22). Against the same decoder with the statistics: the same codes, planes and statistics but the mean
+// weight (NaN where a pixel's test was skipped) and the underflow count (of the pixels tested); the skipped lines are
+// the static ones and those without a residual. Both schedules, both line paths (report planes on and off), one and
+// two threads; at s = 255 the moving lines without a residual underflow Eq. 6, so the underflow count shows that the
+// test did not run there.
 TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
   const EncoderConfig link = link_config(0.5, 0, true);
-  const std::vector<LinkFrame> frames = encode_sequence(scene_images("discs", 64, 48, 8), link);
+  const std::vector<LinkFrame> frames = encode_sequence(scene_images("discs", 150, 48, 8), link);
   for (const double sensitivity : {10.0, 255.0}) {
     for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
       for (const bool planes : {false, true}) {
@@ -140,6 +176,7 @@ TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
           FixedFrameDecoder frame(without);
           std::uint64_t extra_lines = 0;
           std::uint64_t fewer_underflows = 0;  // frames whose skipped lines held underflowing pixels
+          std::uint64_t skipped_in_lines = 0;  // reduced frames that skipped runs of lines with a residual alone
           for (const LinkFrame& f : frames) {
             const std::string where = panel + (planes ? " planes" : " codes") + " threads=" + std::to_string(threads) +
                                       " s=" + std::to_string(sensitivity) + " t=" + std::to_string(f.meta.index) +
@@ -174,8 +211,12 @@ TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
             extra_lines += extra;
             if (extra > 0) {
               EXPECT_TRUE(std::isnan(b.stats.mean_motion_weight)) << where;
+            }
+            if (std::isnan(b.stats.mean_motion_weight)) {
+              EXPECT_FALSE(std::isnan(a.stats.mean_motion_weight)) << where;
               EXPECT_LE(off.weight_underflow, on.weight_underflow) << where;
               fewer_underflows += off.weight_underflow < on.weight_underflow ? 1 : 0;
+              skipped_in_lines += extra == 0 && f.meta.parity == Parity::Reduced ? 1 : 0;
             } else {
               EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
               EXPECT_EQ(on.weight_underflow, off.weight_underflow) << where;
@@ -183,6 +224,9 @@ TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
             if (HasFatalFailure()) return;
           }
           EXPECT_GT(extra_lines, 0u) << panel << " the scene has moving lines without a residual";
+          if (!planes) {  // (the report planes' per-sample path runs the whole line)
+            EXPECT_GT(skipped_in_lines, 0u) << panel << " runs without a residual in lines with one";
+          }
           if (sensitivity == 255.0) {
             EXPECT_GT(fewer_underflows, 0u) << panel << " the skipped lines' pixels were not tested";
           }

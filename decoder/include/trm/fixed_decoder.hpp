@@ -160,14 +160,15 @@ struct FixedDecoderConfig {
   // 59 MiB at 2160x1200) besides the drive codes, the hardware's output. false leaves them empty: what a testbench,
   // a rig feed or a throughput run needs; the LCD's report drive value (a division per sample) is then not computed.
   bool report_planes = true;
-  // The frame's mean motion weight and weight-underflow count over every pixel of a reduced frame. On a line whose
-  // residual is all zero (the residual skip above) w weighs nothing, alpha' = clamp(alpha), and the motion test
-  // runs only for these statistics. false skips it there, with U of d_{t-1} and its reads, as a controller without
-  // these counters would (counted in motion_test_lines_skipped); the codes are the same bits, the frame's
-  // mean_motion_weight is then NaN (not measured) where a line skipped it, weight_underflow counts the lines
-  // whose motion test ran, and grey_lines may count more lines (a skipped line's chroma skip no longer depends on
-  // the d_{t-1} rows it does not read). No effect with skip_unneeded false or with stage taps (test vectors record w
-  // everywhere).
+  // The frame's mean motion weight and weight-underflow count over every pixel of a reduced frame. Where a pixel's
+  // residual is zero w weighs nothing (alpha' = clamp(alpha)), and the motion test runs there only for these
+  // statistics. false skips it there, with U of d_{t-1} and its reads, as a controller without these counters
+  // would: on a line whose residual is all zero (the residual skip above; counted in motion_test_lines_skipped),
+  // and on a line with a residual outside the runs of kMotionRunPixels pixels (fixed_core.hpp) that hold a
+  // residual sample that is not 0. The codes are the same bits; the frame's mean_motion_weight is then NaN (not
+  // measured) where a line skipped any pixel, weight_underflow counts the pixels whose motion test ran, and
+  // grey_lines may count more lines (a skipped line's chroma skip no longer depends on the d_{t-1} rows it does not
+  // read). No effect with skip_unneeded false or with stage taps (test vectors record w everywhere).
   // What a rig feed or a throughput run needs.
   bool motion_weight_statistics = true;
   // FixedStreamingDecoder::decode of a whole view: bands of output lines on this many threads, each band with its
