@@ -335,43 +335,65 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
       std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
       m.weight_sum = motion_static ? kernels_.one() * static_cast<Raw>(pixels) : 0;
     }
-    // Eq. 1's alpha and L_{t-1} from the stored d_{t-1} rows (64-bit lines: their kernels measured faster so), w,
-    // and alpha' into 32-bit words where the OLED's drive search reads them (narrow_lines), else 64-bit ones.
-    scratch.first.resize(n);
-    upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);
-    if (previous_needed && !config().motion_weight_statistics && skipping()) {
-      // Without the statistics w weighs only where rho is not 0: the motion test, and U of d_{t-1} before it, run on
-      // the runs of kMotionRunPixels pixels that hold such a sample (2 % of the pixels of the panorama capture's
-      // lines with a residual lay in 14 % of its runs); elsewhere w = 1, which over zeros gives clamp(alpha) as any
-      // w would.
-      scratch.second.resize(n);
-      std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
+    // Without the statistics w weighs only where rho is not 0 (elsewhere any w gives clamp(alpha)): the motion test,
+    // and U of d_{t-1} before it, run on the runs of kMotionRunPixels pixels that hold such a sample (2 % of the
+    // pixels of the panorama capture's lines with a residual lay in 14 % of its runs).
+    const bool by_runs = !residual_zero && !config().motion_weight_statistics && skipping();
+    const auto runs_with_residual = [&](const auto& run) {
       for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
         const std::size_t x1 = std::min(pixels, x0 + kMotionRunPixels);
         std::int32_t any_bits = 0;
         for (std::size_t s = 3 * x0; s < 3 * x1; ++s) any_bits |= residual_row[s];
-        if (any_bits == 0) continue;
-        blend_line(prev0, prev1, g, y, *plans.eotf, scratch.second_rows, scratch.second.data(), 3 * x0, 3 * x1);
-        lines::motion_weights(scratch.second.data() + 3 * x0, scratch.first.data() + 3 * x0, x1 - x0, *motion,
-                              kernels_, scratch.weight.data() + x0, m);
+        if (any_bits != 0) run(x0, x1);
       }
-      ++out.tally.unweighed_lines;  // w of the other runs not measured
-    } else if (previous_needed) {
-      scratch.second.resize(n);
-      upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
-      lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,
-                            scratch.weight.data(), m);
-    }
-    if (narrow_lines(out)) {
+    };
+    const auto weigh_run = [&](std::size_t x0, std::size_t x1) {
+      blend_line(prev0, prev1, g, y, *plans.eotf, scratch.second_rows, scratch.second.data(), 3 * x0, 3 * x1);
+      lines::motion_weights(scratch.second.data() + 3 * x0, scratch.first.data() + 3 * x0, x1 - x0, *motion,
+                            kernels_, scratch.weight.data() + x0, m);
+    };
+    // Eq. 1's alpha and L_{t-1} from the stored d_{t-1} rows (64-bit lines: their kernels measured faster so), w,
+    // and alpha' into 32-bit words where the OLED's drive search reads them (narrow_lines), else 64-bit ones.
+    scratch.first.resize(n);
+    scratch.second.resize(n);
+    std::uint16_t* codes = out.frame.drive_codes.ptr<std::uint16_t>(y);
+    if (by_runs && narrow_lines(out) && plans.eotf->within_unit && plans.drive && !plans.drive_of_node.empty() &&
+        blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, codes)) {
+      // On an OLED with the composed table: the line's codes as if its residual were all zero (alpha' = alpha), then
+      // alpha, w, Eq. 4 and the codes again on the runs that hold a residual.
       scratch.shown32.resize(n);
-      lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
-                                    scratch.shown32.data(), m);
-      emit_line(out, eye, y, scratch.shown32.data(), nullptr);
+      runs_with_residual([&](std::size_t x0, std::size_t x1) {
+        const std::size_t begin = 3 * x0;
+        const std::size_t count = 3 * (x1 - x0);
+        blend_line(in0, in1, g, y, *plans.eotf, scratch.first_rows, scratch.first.data(), begin, 3 * x1);
+        if (previous_needed) weigh_run(x0, x1);
+        lines::add_weighted_residuals(scratch.first.data() + begin, scratch.weight.data() + x0, residual_row + begin,
+                                      count, *motion, kernels_, scratch.shown32.data() + begin, m);
+        lines::drive_codes(scratch.shown32.data() + begin, count, *plans.drive, codes + begin);
+      });
+      if (previous_needed) ++out.tally.unweighed_lines;  // w of the other runs not measured
     } else {
-      scratch.shown.resize(n);
-      lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
-                                    scratch.shown.data(), m);
-      emit_line(out, eye, y, scratch.shown.data(), nullptr);
+      upsample(in0, in1, g, y, scratch.first.data(), grey, scratch.first_rows);
+      if (previous_needed && by_runs) {
+        std::fill(scratch.weight.begin(), scratch.weight.end(), kernels_.one());
+        runs_with_residual(weigh_run);
+        ++out.tally.unweighed_lines;  // w of the other runs not measured
+      } else if (previous_needed) {
+        upsample(prev0, prev1, g, y, scratch.second.data(), grey, scratch.second_rows);
+        lines::motion_weights(scratch.second.data(), scratch.first.data(), pixels, *motion, kernels_,
+                              scratch.weight.data(), m);
+      }
+      if (narrow_lines(out)) {
+        scratch.shown32.resize(n);
+        lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
+                                      scratch.shown32.data(), m);
+        emit_line(out, eye, y, scratch.shown32.data(), nullptr);
+      } else {
+        scratch.shown.resize(n);
+        lines::add_weighted_residuals(scratch.first.data(), scratch.weight.data(), residual_row, n, *motion, kernels_,
+                                      scratch.shown.data(), m);
+        emit_line(out, eye, y, scratch.shown.data(), nullptr);
+      }
     }
     FrameTally& t = out.tally;
     t.weight_sum += m.weight_sum;

@@ -125,27 +125,34 @@ TEST(FixedSkip, BitIdenticalInTheLinearResampleSpaceAndAt10Bits) {
 TEST(FixedSkip, WithoutMotionStatisticsEveryRunHoldingAResidualIsWeighed) {
   const EncoderConfig link = link_config(0.5);
   constexpr int kWidth = 150;
-  for (const int column : {0, 63, 64, 127, 128, 149}) {
-    cv::Mat full(16, kWidth, CV_64FC3, cv::Scalar::all(0.4));
-    full.col(column).setTo(cv::Scalar::all(1.0));
-    const cv::Mat reduced(16, kWidth, CV_64FC3, cv::Scalar::all(0.2));
-    const std::vector<LinkFrame> frames = encode_sequence({full, reduced}, link);
-    ASSERT_EQ(frames.at(1).meta.parity, Parity::Reduced);
-    FixedDecoderConfig with_statistics = fixed_config(link, "vive");
-    with_statistics.report_planes = false;  // the line kernels (the report planes' per-sample path weighs every pixel)
-    FixedDecoderConfig without = with_statistics;
-    without.motion_weight_statistics = false;
-    FixedStreamingDecoder measured(with_statistics);
-    FixedStreamingDecoder streaming(without);
-    for (const LinkFrame& f : frames) {
-      const DecodedFrame a = measured.decode(f);
-      const DecodedFrame b = streaming.decode(f);
-      ASSERT_TRUE(test::identical(a.drive_codes, b.drive_codes)) << "column " << column << " t=" << f.meta.index;
-      if (f.meta.parity == Parity::Full) {
-        ASSERT_GT(a.stats.residual_max_abs, 0.0) << "column " << column << ": the white column clips";
-      } else {
-        EXPECT_LT(a.stats.mean_motion_weight, 1.0) << "column " << column << ": the reduced frame moves";
-        EXPECT_TRUE(std::isnan(b.stats.mean_motion_weight)) << "column " << column << ": runs skipped";
+  // The OLED through the composed table (the line's codes, then the runs with a residual again), the LCD through the
+  // whole line's kernels with w computed on those runs.
+  for (const std::string panel : {"vive", "lcd"}) {
+    for (const int column : {0, 63, 64, 127, 128, 149}) {
+      const std::string where = panel + " column " + std::to_string(column);
+      cv::Mat full(16, kWidth, CV_64FC3, cv::Scalar::all(0.4));
+      full.col(column).setTo(cv::Scalar::all(1.0));
+      const cv::Mat reduced(16, kWidth, CV_64FC3, cv::Scalar::all(0.2));
+      const std::vector<LinkFrame> frames = encode_sequence({full, reduced}, link);
+      ASSERT_EQ(frames.at(1).meta.parity, Parity::Reduced);
+      FixedDecoderConfig with_statistics = fixed_config(link, panel);
+      with_statistics.report_planes = false;  // the line kernels (the report planes' per-sample path weighs every pixel)
+      FixedDecoderConfig without = with_statistics;
+      without.motion_weight_statistics = false;
+      FixedStreamingDecoder measured(with_statistics);
+      FixedStreamingDecoder streaming(without);
+      for (const LinkFrame& f : frames) {
+        const DecodedFrame a = measured.decode(f);
+        const DecodedFrame b = streaming.decode(f);
+        ASSERT_TRUE(test::identical(a.drive_codes, b.drive_codes)) << where << " t=" << f.meta.index;
+        EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
+        EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
+        if (f.meta.parity == Parity::Full) {
+          ASSERT_GT(a.stats.residual_max_abs, 0.0) << where << ": the white column clips";
+        } else {
+          EXPECT_LT(a.stats.mean_motion_weight, 1.0) << where << ": the reduced frame moves";
+          EXPECT_TRUE(std::isnan(b.stats.mean_motion_weight)) << where << ": runs skipped";
+        }
       }
     }
   }
