@@ -481,28 +481,36 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const Linear* linear, [[maybe_unus
     for (std::size_t i = 0; i < lanes; ++i) out[at + i] = drive_scalar(linear[at + i], at + i, p);
   };
   if (packed) {
-    // One lookup per sample (DrivePlan::packed32): x's bits below its bucket's lower end against the next threshold's
-    // offset. In passes (kPassChunk): the words' places and those bits, the words, the codes.
+    // One lookup per sample (DrivePlan::packed32): the bucket from x's float, x's bits below the bucket's lower end
+    // against the next threshold's offset. In passes (kPassChunk): the words' places and those bits, the words, the
+    // codes.
     HWY_ALIGN std::uint32_t words[kPassChunk];
     HWY_ALIGN std::uint32_t below[kPassChunk];
     std::array<bool, kPassChunk> by_generic_search{};
-    const std::int32_t* bucket_offset = p.bucket_offset32.data();  // locals: a vector store may alias the plan
+    const std::int32_t* packed_offset = p.packed_offset32.data();  // locals: a vector store may alias the plan
     const int offset_bits = p.offset_bits;
+    const int fraction_shift = 23 - m;
+    const auto keep_all = hn::Set(d, std::int32_t{-1});
+    const auto keep_top = hn::Set(d, ~std::int32_t{63});  // from 2^24 (below 2^30): the float's 24 bits
+    const auto below_fraction = hn::Set(du, (std::uint32_t{1} << fraction_shift) - 1);
+    const auto first_bucket = hn::Set(d, std::int32_t{126} << m);
     while (s + lanes <= n) {
       const std::size_t count = pass_chunk(n - s, lanes);
       for (std::size_t i = 0; i < count; i += lanes, phase = next_phase(phase, phase_step)) {
-        Place place;
-        by_generic_search[i] = !place_of(s + i, place);
+        hn::Vec<decltype(d)> x;
+        by_generic_search[i] = !load_x(s + i, x);
         if (by_generic_search[i]) {
           generic(s + i);
           hn::Store(hn::Zero(du), du, words + i);
           continue;
         }
-        const auto small = hn::Lt(place.x, direct);
-        const auto bucket = hn::IfThenElse(small, place.x, hn::Add(hn::ShiftLeftSame(place.octave, m), place.top_bits));
-        hn::Store(hn::BitCast(du, hn::Add(bucket, hn::LoadU(d, bucket_offset + phase))), du, words + i);
-        const auto below_bits = hn::Sub(hn::Shl(one32, hn::BitCast(du, hn::Max(hn::Sub(place.octave, hn::BitCast(d, one32)), hn::Zero(d)))), one32);
-        hn::Store(hn::IfThenZeroElse(hn::RebindMask(du, small), hn::And(hn::BitCast(du, place.x), below_bits)), du, below + i);
+        const auto exact = hn::And(x, hn::IfThenElse(hn::Lt(x, exact_float), keep_all, keep_top));
+        const auto bits = hn::BitCast(du, hn::ConvertTo(df, exact));
+        const auto bucket = hn::Max(hn::Sub(hn::BitCast(d, hn::ShiftRightSame(bits, fraction_shift)), first_bucket),
+                                    hn::Zero(d));
+        hn::Store(hn::BitCast(du, hn::Add(bucket, hn::LoadU(d, packed_offset + phase))), du, words + i);
+        const auto lo = hn::ConvertTo(d, hn::BitCast(df, hn::AndNot(below_fraction, bits)));
+        hn::Store(hn::BitCast(du, hn::Sub(x, lo)), du, below + i);
       }
       look_up(reinterpret_cast<const std::uint32_t*>(packed_words), words, count);
       for (std::size_t i = 0; i < count; i += lanes) {
@@ -1700,31 +1708,52 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
 
 namespace {
 
-// DrivePlan::packed32 for a plan whose 32-bit tables are built, where every channel needs at most one step.
+// DrivePlan::packed32 for a plan whose 32-bit tables are built, where every channel's every bucket holds at most one
+// threshold.
 void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, DrivePlan& d) {
   const int m = d.mantissa_bits;
   const int value_bits = channels[0]->value_bits();
   const int offset_bits = value_bits - m;  // a bucket is at most 2^(value_bits - 1 - m) wide
   int code_bits = 0;
   for (const ThresholdIndex* index : channels) {
-    if (index->steps() != 1) return;
+    if (index->steps() < 1) return;
     code_bits = std::max(code_bits, static_cast<int>(std::bit_width(index->padded().size())));
   }
-  if (offset_bits < 1 || offset_bits + code_bits > 32) return;
-  std::vector<std::uint32_t> packed;
-  packed.reserve(d.base32.size());
-  for (const ThresholdIndex* index : channels) {
-    const std::vector<std::int64_t>& padded = index->padded();
-    for (std::size_t b = 0; b < index->base().size(); ++b) {
-      const auto [lo, width] = ThresholdIndex::bucket_range(b);
-      const std::uint16_t k = index->base()[b];
-      const std::int64_t next = padded[std::size_t{k} + 1];  // above lo (k is lo's code); the padding is INT64_MAX
-      if (next <= lo) return;
+  if (value_bits > 30 || m > 16 || offset_bits < 1 || offset_bits + code_bits > 32) return;
+  // Bucket b >= 2^m: leading one e = (b >> m) - 1, the m fraction bits f = b mod 2^m; below e = m a bucket is one
+  // value, and exists where f's low m - e bits are 0. Bucket 0 is x = 0; buckets 1 .. 2^m - 1 are never addressed.
+  const std::int32_t buckets = (value_bits + 1) << m;
+  std::vector<std::uint32_t> packed(3 * static_cast<std::size_t>(buckets), 0);
+  for (std::size_t ch = 0; ch < 3; ++ch) {
+    const ThresholdIndex& index = *channels[ch];
+    const std::vector<std::int64_t>& padded = index.padded();
+    for (std::int32_t b = 0; b < buckets; ++b) {
+      if (b > 0 && b < (1 << m)) continue;
+      std::int64_t lo = 0;
+      std::int64_t width = 1;
+      if (b > 0) {
+        const int e = (b >> m) - 1;
+        const std::int64_t f = b & ((1 << m) - 1);
+        if (e >= m) {
+          lo = ((std::int64_t{1} << m) + f) << (e - m);
+          width = std::int64_t{1} << (e - m);
+        } else {
+          if ((f & ((std::int64_t{1} << (m - e)) - 1)) != 0) continue;
+          lo = (std::int64_t{1} << e) + (f >> (m - e));
+        }
+      }
+      const std::uint16_t k = index.search(lo);
+      const std::int64_t next = padded[std::size_t{k} + 1];  // above lo (k is lo's code); the padding no x reaches
+      if (next <= lo || index.search(lo + width - 1) > k + 1) return;  // two thresholds inside: not one lookup
       const std::int64_t offset = next - lo < width ? next - lo : width;
-      packed.push_back((std::uint32_t{k} << offset_bits) | static_cast<std::uint32_t>(offset));
+      packed[ch * static_cast<std::size_t>(buckets) + static_cast<std::size_t>(b)] =
+          (std::uint32_t{k} << offset_bits) | static_cast<std::uint32_t>(offset);
     }
   }
   d.packed32 = std::move(packed);
+  d.packed_buckets = buckets;
+  d.packed_offset32.clear();
+  for (int i = 0; i < 3 + DrivePlan::kMaxLanes; ++i) d.packed_offset32.push_back((i % 3) * buckets);
   d.offset_bits = offset_bits;
 }
 

@@ -103,11 +103,16 @@ struct DrivePlan {
   std::vector<std::int32_t> bucket_offset32;
   std::vector<std::int32_t> threshold_offset32;
   // Where no bucket of any channel holds more than one threshold (steps == 1: 8-bit output at the default formats),
-  // the search is one gather: per bucket (at base32's positions), the channel's code at the bucket's lower end lo,
-  // shifted left by offset_bits, above the offset T_{k+1} - lo of the next threshold where it lies in the bucket, else
-  // the bucket's width, which no offset within the bucket reaches. The code is k, plus one where x - lo reaches the
-  // offset. Empty otherwise.
+  // the search is one lookup: per bucket, the channel's code at the bucket's lower end lo, shifted left by
+  // offset_bits, above the offset T_{k+1} - lo of the next threshold where it lies in the bucket, else the bucket's
+  // width, which no offset within the bucket reaches. The code is k, plus one where x - lo reaches the offset. The
+  // buckets are addressed by x's float: its bits shifted right by 23 - m (exponent and top m fraction bits) less
+  // 126 << m, 0 for x = 0 (x from 2^24 on with its low six bits cleared first, so that the float is exact and the
+  // bucket unchanged), and lo is that float with the fraction bits below the top m cleared: packed_buckets words per
+  // channel, from packed_offset32[i mod 3] (i < 3 + kMaxLanes, as bucket_offset). Empty otherwise.
   std::vector<std::uint32_t> packed32;
+  std::vector<std::int32_t> packed_offset32;
+  std::int32_t packed_buckets = 0;
   int offset_bits = 0;
 };
 
