@@ -147,8 +147,10 @@ struct RowBand {
 // The bands of a view: equal shares of the output rows, none shorter than kMinBandRows (a band re-reads the
 // Gaussian's support above it, so short bands waste work).
 constexpr int kMinBandRows = 64;
-// Bands per thread of a whole view (FixedStreamingDecoder::decode_in_bands).
-constexpr int kBandsPerThread = 4;
+// Bands per thread of a whole view (FixedStreamingDecoder::decode_in_bands): more than one, so that a thread held up
+// by other work on its core leaves part of its share to the others, and few, as each band computes D's support above
+// it again (docs/performance_history.md).
+constexpr int kBandsPerThread = 2;
 
 std::vector<RowBand> row_bands(const Geometry& g, int threads) {
   const int count = std::max(1, std::min(threads, g.full.height / kMinBandRows));
