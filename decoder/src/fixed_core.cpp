@@ -247,6 +247,10 @@ void FixedDecoderCore::full_line(FrameOutput& out, EyeState& eye, const Geometry
       Raw* rho = scratch.shortfall.data();
       for (std::size_t s = 0; s < n; ++s) rho[s] += scratch.rho32[s];
       scratch.residual_nonzero = lines::store_residuals(rho, n, kernels_, residual_row, stored);
+    } else if (clipped == 0) {  // rho = beta - clamp(beta) is 0 on the whole line, and so is what the store holds
+      emit_line(out, eye, y, scratch.shown32.data(), nullptr);
+      std::fill_n(residual_row, n, 0);
+      scratch.residual_nonzero = false;
     } else {
       emit_line(out, eye, y, scratch.shown32.data(), nullptr);
       scratch.residual_nonzero = lines::store_residuals(scratch.rho32.data(), n, kernels_, residual_row, stored);
