@@ -8,17 +8,24 @@
 
 namespace trm {
 
+namespace {
+
+// A row's largest code, compiled for AVX2 too and chosen at run time (GCC's function multi-versioning): the x86-64
+// baseline has no unsigned 16-bit maximum (SSE4.1's), and a decoder runs this over every code of every view.
+[[gnu::target_clones("avx2", "default")]] std::uint16_t row_highest(const std::uint16_t* row, std::size_t n) {
+  std::uint16_t highest = 0;
+  for (std::size_t i = 0; i < n; ++i) highest = std::max(highest, row[i]);
+  return highest;
+}
+
+}  // namespace
+
 std::uint16_t highest_code(const cv::Mat& codes) {
   if (codes.empty()) return 0;
   if (codes.depth() != CV_16U) throw std::invalid_argument("highest_code: codes must be CV_16U");
   const auto samples = static_cast<std::size_t>(codes.cols) * static_cast<std::size_t>(codes.channels());
   std::uint16_t highest = 0;
-  for (int y = 0; y < codes.rows; ++y) {
-    const auto* row = codes.ptr<std::uint16_t>(y);
-    std::uint16_t row_highest = 0;
-    for (std::size_t i = 0; i < samples; ++i) row_highest = std::max(row_highest, row[i]);
-    highest = std::max(highest, row_highest);
-  }
+  for (int y = 0; y < codes.rows; ++y) highest = std::max(highest, row_highest(codes.ptr<std::uint16_t>(y), samples));
   return highest;
 }
 
