@@ -35,6 +35,14 @@ EyeState& FixedDecoderCore::begin(const FrameMeta& meta) {
 
 namespace {
 
+// Whether any of n values is not 0, compiled for AVX2 too and chosen at run time (GCC's function multi-versioning):
+// the residual flags of a full line, read over each run it stores.
+[[gnu::target_clones("avx2", "default")]] bool any_nonzero(const std::int32_t* values, std::size_t n) {
+  std::int32_t any_bits = 0;
+  for (std::size_t i = 0; i < n; ++i) any_bits |= values[i];
+  return any_bits != 0;
+}
+
 // How many hold a plane's data. Read with acquire order: a caller lets a view go on a thread of its own (trm feed's
 // sending thread), and its last reads of the plane must come before a reuse writes it.
 int owners(const cv::Mat& m) {
@@ -342,13 +350,15 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     // Without the statistics w weighs only where rho is not 0 (elsewhere any w gives clamp(alpha)): the motion test,
     // and U of d_{t-1} before it, run on the runs of kMotionRunPixels pixels that hold such a sample (2 % of the
     // pixels of the panorama capture's lines with a residual lay in 14 % of its runs).
-    const bool by_runs = !residual_zero && !config().motion_weight_statistics && skipping();
+    const bool by_runs = !residual_zero && !config().motion_weight_statistics && skipping() &&
+                         eye.residual_run_nonzero.size() ==
+                             static_cast<std::size_t>(g.full.height) * motion_runs(g.full.width);
+    // (the full frame's end_full_line kept its runs' flags where by_runs holds)
+    const std::uint8_t* run_flags =
+        eye.residual_run_nonzero.data() + static_cast<std::size_t>(y) * motion_runs(g.full.width);
     const auto runs_with_residual = [&](const auto& run) {
       for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
-        const std::size_t x1 = std::min(pixels, x0 + kMotionRunPixels);
-        std::int32_t any_bits = 0;
-        for (std::size_t s = 3 * x0; s < 3 * x1; ++s) any_bits |= residual_row[s];
-        if (any_bits != 0) run(x0, x1);
+        if (run_flags[x0 / kMotionRunPixels] != 0) run(x0, std::min(pixels, x0 + kMotionRunPixels));
       }
     };
     const auto weigh_run = [&](std::size_t x0, std::size_t x1) {
@@ -498,6 +508,7 @@ void FixedDecoderCore::full_pixel(FrameOutput& out, EyeState& eye, int y, int x,
 void FixedDecoderCore::start_full_lines(EyeState& eye, const Geometry& g) const {
   if (!skipping()) return;
   eye.residual_nonzero.assign(static_cast<std::size_t>(g.full.height), 0);
+  eye.residual_run_nonzero.assign(static_cast<std::size_t>(g.full.height) * motion_runs(g.full.width), 0);
   eye.residual_grey.assign(static_cast<std::size_t>(g.full.height), 0);
   eye.low_grey.assign(static_cast<std::size_t>(g.reduced.height), 0);
 }
@@ -512,11 +523,16 @@ void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, con
   if (scratch.residual_nonzero) {
     nonzero = *scratch.residual_nonzero;
   } else {
-    std::int32_t any_bits = 0;  // an OR over the line, which the compiler vectorises (an all-zero line reads it all)
-    for (int i = 0; i < samples; ++i) any_bits |= residual_row[i];
-    nonzero = any_bits != 0;
+    nonzero = any_nonzero(residual_row, static_cast<std::size_t>(samples));  // (an all-zero line reads it all)
   }
   eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
+  if (nonzero) {  // (the runs of a line all zero keep the 0 start_full_lines gave them)
+    const auto pixels = static_cast<std::size_t>(eye.full_size.width);
+    std::uint8_t* runs = eye.residual_run_nonzero.data() + static_cast<std::size_t>(y) * motion_runs(eye.full_size.width);
+    for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
+      runs[x0 / kMotionRunPixels] = any_nonzero(residual_row + 3 * x0, 3 * (std::min(pixels, x0 + kMotionRunPixels) - x0));
+    }
+  }
   // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel); a line
   // all zero is grey without a second read.
   const bool grey = !nonzero || FixedKernels::grey_line(residual_row, eye.full_size.width);

@@ -57,6 +57,9 @@ struct EyeState {
   cv::Mat residual;       // rho, full size, CV_32SC3 raw residual format
   cv::Mat previous_low;   // d_t codes, reduced size, CV_16UC3
   std::vector<std::uint8_t> residual_nonzero;  // DESIGN §7 skip: one flag bit per full line, rho not all zero there
+  // And one per run of kMotionRunPixels pixels of each line (line y's runs from y * runs), which a reduced line reads
+  // for the runs that hold a residual (without the motion statistics) in place of the stored rho itself.
+  std::vector<std::uint8_t> residual_run_nonzero;
   // DESIGN §7 chroma skip: one grey flag per row of the d_t store (from the flags of its D taps) and per line of the
   // residual store (R = G = B in the stored rho); empty when not skipping.
   std::vector<std::uint8_t> low_grey;
@@ -79,6 +82,9 @@ cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type);
 // Without FixedDecoderConfig::motion_weight_statistics, a reduced line with a residual runs the motion test on the
 // runs of this many pixels that hold a residual sample that is not 0 (FixedDecoderCore::reduced_line).
 inline constexpr std::size_t kMotionRunPixels = 64;
+inline std::size_t motion_runs(int width) {
+  return (static_cast<std::size_t>(width) + kMotionRunPixels - 1) / kMotionRunPixels;
+}
 
 // The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
 // flags of its U source rows and the full frame's residual line flag.
