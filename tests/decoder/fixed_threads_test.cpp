@@ -109,8 +109,8 @@ TEST(FixedThreads, ViewsWithLostLinesAndLostViewsMatchOnePipeline) {
   }
 }
 
-// A tall view is cut into more bands than threads (four per thread, each taken by the next thread free): 96 x 640 is
-// 8 bands on 2 threads and 10 on 3, in whatever order the threads take them, with the same bits as one pipeline.
+// A tall view is cut into more bands than threads (two per thread, each taken by the next thread free): 96 x 640 is
+// 4 bands on 2 threads and 6 on 3, in whatever order the threads take them, with the same bits as one pipeline.
 TEST(FixedThreads, MoreBandsThanThreadsGiveTheOnePipelineBits) {
   for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
     FixedDecoderConfig config = fixed_config(link_config(0.5, 0, true), panel);
