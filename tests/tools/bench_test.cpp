@@ -31,6 +31,7 @@ TEST(Bench, QuickWritesEveryContenderWithFinitePositiveFigures) {
   std::ifstream in(json_path);
   const nlohmann::json report = nlohmann::json::parse(in);
   expect_positive(report["machine"]["hardware_threads"], "hardware_threads");
+  EXPECT_EQ(report["parameters"]["skip_unneeded"], true);
   const nlohmann::json& results = report["results"];
   ASSERT_TRUE(results.is_array());
   ASSERT_EQ(results.size(), 4u);  // two sizes x (OLED, LCD)
@@ -140,6 +141,22 @@ TEST(Bench, FormatSetsAreAppliedCheckedAndRecorded) {
     EXPECT_EQ(result.output.find("Mpix/s"), std::string::npos) << bad << ": rejected before any work";
     EXPECT_FALSE(std::ifstream(rejected_path).good()) << bad;
   }
+}
+
+// --no-skip times the fixed-point decoders with every step run (the rate no content goes below), says so and records
+// it; their codes are still the reference's by DESIGN §6.
+TEST(Bench, NoSkipRunsEveryStepAndSaysSo) {
+  ScratchDir dir("trm_bench_no_skip_");
+  const std::string json_path = dir.str("bench.json");
+  const auto result = run_trm("bench --quick --size 128x96 --panel vive --only fixed --no-skip --json " + json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("no skips"), std::string::npos) << result.output;
+  std::ifstream in(json_path);
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["parameters"]["skip_unneeded"], false);
+  ASSERT_EQ(report["results"].size(), 1u);
+  expect_positive(report["results"][0]["reference_agreement"]["codes"], "agreement codes");
+  EXPECT_EQ(report["results"][0]["reference_agreement"]["meets_design_6"], true) << result.output;
 }
 
 }  // namespace

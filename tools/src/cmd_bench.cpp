@@ -68,6 +68,7 @@ struct BenchOptions {
   int threads = 0;                  // the streaming decoder's threads; 0: the machine's hardware threads
   std::vector<std::string> only;    // contenders to time besides the OpenCV yardstick; empty: all
   std::vector<std::string> formats;  // KNOB=VALUE: a format set of the fixed-point decoders (trm sweep's knobs)
+  bool no_skip = false;  // FixedDecoderConfig::skip_unneeded = false: the rate where the content lets nothing skip
 };
 
 // A fixed-point format set from --format KNOB=VALUE, by `trm sweep`'s knobs (one home for their names and for how
@@ -214,8 +215,9 @@ FixedDecoderConfig config_for(const BenchSize& size, const std::string& panel, c
 // An LCD reference adopts the fixed decoder's codes as its panel history after every view (the synchronised
 // comparison the criterion is judged on: README "Accuracy").
 Json reference_agreement(const FixedDecoderConfig& config, const std::vector<LinkFrame>& views, std::ostream& text) {
-  FixedDecoderConfig codes_only = config;
+  FixedDecoderConfig codes_only = config;  // as the `fixed` contender runs
   codes_only.report_planes = false;
+  codes_only.motion_weight_statistics = kFixedMotionWeightStatistics;
   const std::unique_ptr<HeadsetDecoder> fixed = make_decoder("fixed", codes_only);
   const std::unique_ptr<HeadsetDecoder> reference = make_decoder("reference", config);
   auto* const synchronised = dynamic_cast<ReferenceDecoder*>(reference.get());
@@ -269,7 +271,8 @@ Json hardware_memory(const FixedDecoderConfig& config, const BenchSize& size) {
 }
 
 Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptions& options, std::ostream& text) {
-  const FixedDecoderConfig config = config_for(size, panel, options.formats);
+  FixedDecoderConfig config = config_for(size, panel, options.formats);
+  config.skip_unneeded = !options.no_skip;
   const std::vector<LinkFrame> views = encode_views(size, options, config.decoder.link);
   std::vector<Contender> contenders;
   // The hardware model's output is the drive codes: the streaming decoder without the report planes, on the
@@ -354,6 +357,7 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
                  {"hw_report_memory", hardware_memory(config, size)}};
   text << "\n" << size.label() << ", " << panel << ", r = 0.5, " << options.scene << ", "
        << static_cast<int>(link_frames) << " frames, median of " << repeats << ", " << formats_label(options.formats)
+       << (options.no_skip ? ", no skips" : "")
        << "\n";
   text << "  " << std::left << std::setw(16) << "decoder" << std::right << std::setw(9) << "Mpix/s" << std::setw(11)
        << "ms/frame" << std::setw(10) << "vs cv" << std::setw(9) << "RT@90" << std::setw(9) << "RT@120"
@@ -418,6 +422,9 @@ void register_bench(CLI::App& app, Action& action) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--pairs", options->pairs, "Frame pairs decoded per repeat (default 2)")->check(CLI::Range(1, 1000));
   cmd->add_option("--scene", options->scene, "Scene to encode")->capture_default_str();
+  cmd->add_flag("--no-skip", options->no_skip,
+                "Fixed-point decoders: run every step where the content would let one skip (static lines, residual "
+                "zero lines and runs): the rate no scene goes below; the codes are the same");
   cmd->add_option("--json", options->json, "Also write the figures as JSON to FILE");
   cmd->add_option("--size", options->sizes,
                   "View size WxH, or WxHs for a stereo pair (repeatable; default 1080x1200s 2160x1200 2880x1600)");
@@ -458,7 +465,8 @@ void register_bench(CLI::App& app, Action& action) {
       Json report = {{"machine", {{"hardware_threads", std::thread::hardware_concurrency()},
                                   {"load_average_at_start", {load[0], load[1], load[2]}}}},
                      {"parameters", {{"reduction", 0.5}, {"scene", o.scene}, {"pairs", o.pairs},
-                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats}}}};
+                                     {"repeats", o.repeats}, {"quick", o.quick}, {"formats", o.formats},
+                                     {"skip_unneeded", !o.no_skip}}}};
       Json results = Json::array();
       std::cout << "trm bench: " << std::thread::hardware_concurrency() << " hardware threads, load average "
                 << load[0] << " at start; OpenCV threads " << cv::getNumThreads() << "\n";
