@@ -267,17 +267,27 @@ BENCHMARK(BM_LineBlendColumns);
 // Into a 32-bit line (an OLED full frame's L_t, `<int>`) or a 64-bit one (alpha and L_{t-1}, and every LCD line,
 // `<long>`); Eq. 2 and the drive codes below likewise (OLED `<int>`). Arg: 0 = as the decoder runs it at r = 1/2
 // (quarter weights: the exact blend, one node per sample), 1 = the ROM interpolation every other r takes.
+// The column blends of two random reduced rows: the row blend's top and bottom operands.
+struct ColumnBlends {
+  ColumnBlends(const FixedKernels& kernels, const Geometry& g) {
+    trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 2).data(),
+                                            g.column_blend, top.size(), top.data());
+    trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 3).data(),
+                                            g.column_blend, bottom.size(), bottom.data());
+  }
+  std::vector<std::uint32_t> top = std::vector<std::uint32_t>(3 * static_cast<std::size_t>(kWidth));
+  std::vector<std::uint32_t> bottom = std::vector<std::uint32_t>(3 * static_cast<std::size_t>(kWidth));
+};
+
 template <typename Line>
 void BM_LineBlendRowsEotf(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
   const int column_bits = state.range(0) == 0 ? g.column_blend.weight_bits : 31;
   const auto n = static_cast<std::size_t>(3 * kWidth);
-  std::vector<std::uint32_t> top(n), bottom(n);
-  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 2).data(),
-                                          g.column_blend, n, top.data());
-  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 3).data(),
-                                          g.column_blend, n, bottom.data());
+  const ColumnBlends blends(kernels, g);
+  const std::vector<std::uint32_t>& top = blends.top;
+  const std::vector<std::uint32_t>& bottom = blends.bottom;
   std::vector<Line> out(n);
   for (auto _ : state) {
     trm::fixed_detail::lines::blend_rows_eotf(top.data(), bottom.data(), n,
@@ -296,11 +306,9 @@ void BM_LineBlendRowsDrive(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
   const auto n = static_cast<std::size_t>(3 * kWidth);
-  std::vector<std::uint32_t> top(n), bottom(n);
-  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 2).data(),
-                                          g.column_blend, n, top.data());
-  trm::fixed_detail::lines::blend_columns(random_codes(3 * g.reduced.width, kernels.max_code(), 3).data(),
-                                          g.column_blend, n, bottom.data());
+  const ColumnBlends blends(kernels, g);
+  const std::vector<std::uint32_t>& top = blends.top;
+  const std::vector<std::uint32_t>& bottom = blends.bottom;
   std::vector<std::uint16_t> codes(n);
   for (auto _ : state) {
     const bool exact = trm::fixed_detail::lines::blend_rows_drive(

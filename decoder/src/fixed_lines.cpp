@@ -265,36 +265,52 @@ HWY_INLINE void StoreLinear(D d, hn::Vec<D> v, Linear* line) {
 }
 #endif
 
+// U's exact path over one output row (EotfPlan::node32): sample s's node place ((2^q_r - r) T' + r B') 2^up from the
+// column blends T = T' 2^down and B = B' 2^down (exactly), for the row weight r over 2^q_r.
+struct ExactRow {
+  ExactRow(const EotfPlan& p, std::uint32_t upper, int column_bits, int row_bits)
+      : down(p.frac_bits - column_bits),
+        r(upper >> (p.frac_bits - row_bits)),
+        r_other((std::uint32_t{1} << row_bits) - r),
+        up(p.segments_log2 - column_bits - row_bits) {}
+  std::uint32_t place(std::uint32_t top, std::uint32_t bottom) const {
+    return (r_other * (top >> down) + r * (bottom >> down)) << up;
+  }
+#if HWY_TARGET != HWY_SCALAR
+  template <class D>
+  HWY_INLINE hn::Vec<D> places(D du, const std::uint32_t* top, const std::uint32_t* bottom) const {
+    const auto t = hn::ShiftRightSame(hn::LoadU(du, top), down);
+    const auto b = hn::ShiftRightSame(hn::LoadU(du, bottom), down);
+    return hn::ShiftLeftSame(hn::Add(hn::Mul(hn::Set(du, r_other), t), hn::Mul(hn::Set(du, r), b)), up);
+  }
+#endif
+  int down;
+  std::uint32_t r;
+  std::uint32_t r_other;
+  int up;
+};
+
 // BlendRowsEotfInto where the blend is exact above the ROM's input (EotfPlan::node32): one 32-bit node per sample.
 template <typename Linear>
 void BlendRowsEotfExact(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                         int column_bits, int row_bits, const EotfPlan& p, Linear* out) {
-  const int down = p.frac_bits - column_bits;  // T = T' 2^down exactly
-  const std::uint32_t r = upper >> (p.frac_bits - row_bits);
-  const std::uint32_t r_other = (std::uint32_t{1} << row_bits) - r;
-  const int up = p.segments_log2 - column_bits - row_bits;
+  const ExactRow row(p, upper, column_bits, row_bits);
   const std::int32_t* node = p.node32.data();
   prefetch_table(p.node32);  // 16 KiB at the defaults
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::uint32_t> du;
   const std::size_t lanes = hn::Lanes(du);
-  const auto weight = hn::Set(du, r);
-  const auto other_weight = hn::Set(du, r_other);
   // In passes (kPassChunk): the nodes' places, then the nodes by scalar loads.
   HWY_ALIGN std::uint32_t places[kPassChunk];
   while (s + lanes <= n) {
     const std::size_t count = pass_chunk(n - s, lanes);
-    for (std::size_t i = 0; i < count; i += lanes) {
-      const auto t = hn::ShiftRightSame(hn::LoadU(du, top + s + i), down);
-      const auto b = hn::ShiftRightSame(hn::LoadU(du, bottom + s + i), down);
-      hn::Store(hn::ShiftLeftSame(hn::Add(hn::Mul(other_weight, t), hn::Mul(weight, b)), up), du, places + i);
-    }
+    for (std::size_t i = 0; i < count; i += lanes) hn::Store(row.places(du, top + s + i, bottom + s + i), du, places + i);
     look_up_into(node, places, count, out + s);
     s += count;
   }
 #endif
-  for (; s < n; ++s) out[s] = node[(r_other * (top[s] >> down) + r * (bottom[s] >> down)) << up];
+  for (; s < n; ++s) out[s] = node[row.place(top[s], bottom[s])];
 }
 
 template <typename Linear>
@@ -353,16 +369,11 @@ void BlendRowsEotfInto(const std::uint32_t* top, const std::uint32_t* bottom, st
 void BlendRowsDriveExact(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
                          int column_bits, int row_bits, const EotfPlan& p, const std::uint16_t* drive_of_node,
                          std::uint16_t* codes) {
-  const int down = p.frac_bits - column_bits;
-  const std::uint32_t r = upper >> (p.frac_bits - row_bits);
-  const std::uint32_t r_other = (std::uint32_t{1} << row_bits) - r;
-  const int up = p.segments_log2 - column_bits - row_bits;
+  const ExactRow row(p, upper, column_bits, row_bits);
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::uint32_t> du;
   const std::size_t lanes = hn::Lanes(du);
-  const auto weight = hn::Set(du, r);
-  const auto other_weight = hn::Set(du, r_other);
   const auto three = hn::Set(du, 3u);
   // Element e: e mod 3, the channels of the samples s0.. of a vector from element s0 mod 3.
   static const std::array<std::uint32_t, 3 + DrivePlan::kMaxLanes> channel_of = [] {
@@ -376,19 +387,14 @@ void BlendRowsDriveExact(const std::uint32_t* top, const std::uint32_t* bottom, 
   while (s + lanes <= n) {
     const std::size_t count = pass_chunk(n - s, lanes);
     for (std::size_t i = 0; i < count; i += lanes, phase = next_phase(phase, phase_step)) {
-      const auto t = hn::ShiftRightSame(hn::LoadU(du, top + s + i), down);
-      const auto b = hn::ShiftRightSame(hn::LoadU(du, bottom + s + i), down);
-      const auto place = hn::ShiftLeftSame(hn::Add(hn::Mul(other_weight, t), hn::Mul(weight, b)), up);
+      const auto place = row.places(du, top + s + i, bottom + s + i);
       hn::Store(hn::Add(hn::Mul(place, three), hn::LoadU(du, channel_of.data() + phase)), du, places + i);
     }
     look_up_into(drive_of_node, places, count, codes + s);
     s += count;
   }
 #endif
-  for (; s < n; ++s) {
-    const std::uint32_t place = (r_other * (top[s] >> down) + r * (bottom[s] >> down)) << up;
-    codes[s] = drive_of_node[3 * static_cast<std::size_t>(place) + s % 3];
-  }
+  for (; s < n; ++s) codes[s] = drive_of_node[3 * static_cast<std::size_t>(row.place(top[s], bottom[s])) + s % 3];
 }
 
 void BlendRowsEotf(const std::uint32_t* top, const std::uint32_t* bottom, std::size_t n, std::uint32_t upper,
