@@ -353,9 +353,9 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     const bool by_runs = !residual_zero && !config().motion_weight_statistics && skipping() &&
                          eye.residual_run_nonzero.size() ==
                              static_cast<std::size_t>(g.full.height) * motion_runs(g.full.width);
-    // (the full frame's end_full_line kept its runs' flags where by_runs holds)
+    // (the full frame's end_full_line kept its runs' flags where by_runs holds; the store is empty otherwise)
     const std::uint8_t* run_flags =
-        eye.residual_run_nonzero.data() + static_cast<std::size_t>(y) * motion_runs(g.full.width);
+        by_runs ? eye.residual_run_nonzero.data() + static_cast<std::size_t>(y) * motion_runs(g.full.width) : nullptr;
     const auto runs_with_residual = [&](const auto& run) {
       for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
         if (run_flags[x0 / kMotionRunPixels] != 0) run(x0, std::min(pixels, x0 + kMotionRunPixels));

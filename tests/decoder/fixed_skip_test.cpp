@@ -2,6 +2,8 @@
 // (static lines skip the motion test, all-zero residual lines skip the residual store traffic) give the same bits
 // as the full path, in both schedules, and count what they skipped.
 #include "fixed_decoder_test_support.hpp"
+#include "fixed_kernels.hpp"
+#include "fixed_lines.hpp"
 
 #include <gtest/gtest.h>
 
@@ -123,13 +125,17 @@ TEST(FixedSkip, BitIdenticalInTheLinearResampleSpaceAndAt10Bits) {
 // next reduced frame, grey 0.2, moves (w < 1 at the column). Against the decoder with the statistics, which weighs
 // every pixel.
 TEST(FixedSkip, WithoutMotionStatisticsEveryRunHoldingAResidualIsWeighed) {
-  const EncoderConfig link = link_config(0.5);
   constexpr int kWidth = 150;
-  // The OLED through the composed table (the line's codes, then the runs with a residual again), the LCD through the
-  // whole line's kernels with w computed on those runs.
-  for (const std::string panel : {"vive", "lcd"}) {
+  // At r = 1/2 the OLED through the composed table (the line's codes, then the runs with a residual again); the LCD,
+  // and both panels at r = 3/4 (U's interpolation over the runs' sub-ranges), through the whole line's kernels with w
+  // computed on those runs.
+  for (const auto& [r, panel] : {std::pair{0.5, "vive"}, {0.5, "lcd"}, {0.75, "vive"}, {0.75, "lcd"}}) {
+    const EncoderConfig link = link_config(r);
+    // (the OLED's table is built at either r; at 3/4 no row is exact, so it is not read)
+    const bool table = !fixed_detail::FixedKernels(fixed_config(link, panel)).line_plans().drive_of_node.empty();
+    ASSERT_EQ(table, std::string(panel) == "vive") << panel << " r=" << r;
     for (const int column : {0, 63, 64, 127, 128, 149}) {
-      const std::string where = panel + " column " + std::to_string(column);
+      const std::string where = std::string(panel) + " r=" + std::to_string(r) + " column " + std::to_string(column);
       cv::Mat full(16, kWidth, CV_64FC3, cv::Scalar::all(0.4));
       full.col(column).setTo(cv::Scalar::all(1.0));
       const cv::Mat reduced(16, kWidth, CV_64FC3, cv::Scalar::all(0.2));
