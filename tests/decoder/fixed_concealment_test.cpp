@@ -69,6 +69,34 @@ TEST(FixedConcealment, StreamingMatchesFrameUnderFaults) {
   }
 }
 
+// Without the motion statistics (the runs of kMotionRunPixels pixels, the composed table) under every kind of
+// arrival: the codes of the decoder that weighs every pixel, view by view, on 150-pixel lines (runs of 64, 64 and 22),
+// both panels, stereo, one and two threads.
+TEST(FixedConcealment, WithoutMotionStatisticsTheCodesAreTheSameUnderFaults) {
+  for (const char* panel : {"vive", "lcd"}) {
+    for (const int threads : {1, 2}) {
+      const EncoderConfig link = link_config(0.5, 0, true);
+      const std::vector<LinkFrame> frames = encode_sequence(scene_images("discs", 150, 128, 9), link);
+      FixedDecoderConfig measured_config = fixed_config(link, panel);
+      measured_config.report_planes = false;
+      measured_config.threads = threads;
+      FixedDecoderConfig fast_config = measured_config;
+      fast_config.motion_weight_statistics = false;
+      FixedStreamingDecoder measured(measured_config);
+      FixedStreamingDecoder fast(fast_config);
+      const ArrivalPlan plan = faulty_link(4);
+      for (std::size_t n = 0; n < frames.size(); ++n) {
+        const Arrival arrival = plan(n, frames[n]);
+        const DecodedFrame a = test::decode_as_arrived(measured, frames[n], arrival);
+        const DecodedFrame b = test::decode_as_arrived(fast, frames[n], arrival);
+        ASSERT_TRUE(test::identical(a.drive_codes, b.drive_codes))
+            << panel << " threads=" << threads << " view " << n << " arrival " << static_cast<int>(arrival.kind);
+        EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << panel << " view " << n;
+      }
+    }
+  }
+}
+
 TEST(FixedConcealment, StreamingMatchesFrameUnderFaultsOnScenesAndOddSizes) {
   const EncoderConfig link = link_config(0.5);
   for (const char* scene : {"discs", "checker", "text"}) {
