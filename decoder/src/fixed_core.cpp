@@ -199,13 +199,13 @@ void blend_line(const std::uint16_t* row0, const std::uint16_t* row1, const Geom
                          g.column_blend.weight_bits, eotf, out + begin);
 }
 
-// The drive codes of output line y straight from U's nodes (lines::blend_rows_drive); false where its exact path does
-// not apply to the row.
+// The drive codes of output line y straight from U's nodes (lines::blend_rows_drive); false where the plans have no
+// composed table (an LCD; a node outside [0, 1]) or its exact path does not apply to the row.
 bool blend_line_codes(const std::uint16_t* row0, const std::uint16_t* row1, const Geometry& g, int y,
                       const FixedLinePlans& plans, ColumnBlendCache& cache, std::uint16_t* codes) {
   const BilinearWeights& row = g.bilinear_rows[static_cast<std::size_t>(y)];
   const std::uint32_t upper = static_cast<std::uint32_t>(row.upper);
-  if (plans.eotf->exact_row_bits(upper, g.column_blend.weight_bits) < 0) return false;
+  if (plans.drive_of_node.empty() || plans.eotf->exact_row_bits(upper, g.column_blend.weight_bits) < 0) return false;
   const std::uint32_t* top = cache.row(row0, row.i0, g.column_blend);
   const std::uint32_t* bottom = cache.row(row1, row.i1, g.column_blend);
   return lines::blend_rows_drive(top, bottom, g.column_blend.upper.size(), upper, g.column_blend.weight_bits,
@@ -324,9 +324,8 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     // never taken, and Eq. 4 adds nothing to the tally): on an OLED its codes are U's nodes' where the composed table
     // applies, else alpha is driven as it is.
     if (residual_zero && !previous_needed && plans.eotf->within_unit) {
-      const bool coded = plans.drive && !plans.drive_of_node.empty() &&
-                         blend_line_codes(in0, in1, g, y, plans, scratch.first_rows,
-                                          out.frame.drive_codes.ptr<std::uint16_t>(y));
+      const bool coded =
+          blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, out.frame.drive_codes.ptr<std::uint16_t>(y));
       if (!coded && narrow_lines(out)) {
         scratch.first32.resize(n);
         upsample(in0, in1, g, y, scratch.first32.data(), scratch.first_rows);
@@ -357,9 +356,9 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     const std::uint8_t* run_flags =
         by_runs ? eye.residual_run_nonzero.data() + static_cast<std::size_t>(y) * motion_runs(g.full.width) : nullptr;
     const auto runs_with_residual = [&](const auto& run) {
-      for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
-        if (run_flags[x0 / kMotionRunPixels] != 0) run(x0, std::min(pixels, x0 + kMotionRunPixels));
-      }
+      for_each_motion_run(pixels, [&](std::size_t index, std::size_t x0, std::size_t x1) {
+        if (run_flags[index] != 0) run(x0, x1);
+      });
     };
     const auto weigh_run = [&](std::size_t x0, std::size_t x1) {
       blend_line(prev0, prev1, g, y, *plans.eotf, scratch.second_rows, scratch.second.data(), 3 * x0, 3 * x1);
@@ -371,8 +370,7 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     scratch.first.resize(n);
     scratch.second.resize(n);
     std::uint16_t* codes = out.frame.drive_codes.ptr<std::uint16_t>(y);
-    if (by_runs && narrow_lines(out) && plans.eotf->within_unit && plans.drive && !plans.drive_of_node.empty() &&
-        blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, codes)) {
+    if (by_runs && narrow_lines(out) && blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, codes)) {
       // On an OLED with the composed table: the line's codes as if its residual were all zero (alpha' = alpha), then
       // alpha, w, Eq. 4 and the codes again on the runs that hold a residual.
       scratch.shown32.resize(n);
@@ -517,22 +515,19 @@ void FixedDecoderCore::end_full_line(FrameOutput& out, EyeState& eye, int y, con
                                      const LineScratch& scratch) const {
   if (!skipping()) return;
   // The OR of the line's residual samples, accumulated as they are produced (one flip-flop) and kept as the line's
-  // flag: a line held all zero is not written to the store.
-  const int samples = 3 * eye.full_size.width;
+  // flag: a line held all zero is not written to the store. It is the OR of the line's runs' flags (each the OR of the
+  // run's samples), and a line its store kernel found all zero is not read again (its runs keep the 0 that
+  // start_full_lines gave them).
   bool nonzero = false;
-  if (scratch.residual_nonzero) {
-    nonzero = *scratch.residual_nonzero;
-  } else {
-    nonzero = any_nonzero(residual_row, static_cast<std::size_t>(samples));  // (an all-zero line reads it all)
-  }
-  eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
-  if (nonzero) {  // (the runs of a line all zero keep the 0 start_full_lines gave them)
+  if (scratch.residual_nonzero.value_or(true)) {
     const auto pixels = static_cast<std::size_t>(eye.full_size.width);
     std::uint8_t* runs = eye.residual_run_nonzero.data() + static_cast<std::size_t>(y) * motion_runs(eye.full_size.width);
-    for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
-      runs[x0 / kMotionRunPixels] = any_nonzero(residual_row + 3 * x0, 3 * (std::min(pixels, x0 + kMotionRunPixels) - x0));
-    }
+    for_each_motion_run(pixels, [&](std::size_t index, std::size_t x0, std::size_t x1) {
+      runs[index] = any_nonzero(residual_row + 3 * x0, 3 * (x1 - x0)) ? 1 : 0;
+      nonzero = nonzero || runs[index] != 0;
+    });
   }
+  eye.residual_nonzero[static_cast<std::size_t>(y)] = nonzero ? 1 : 0;
   // The residual line's grey flag (R = G = B in every stored rho: an LCD shortfall can differ per channel); a line
   // all zero is grey without a second read.
   const bool grey = !nonzero || FixedKernels::grey_line(residual_row, eye.full_size.width);

@@ -85,6 +85,13 @@ inline constexpr std::size_t kMotionRunPixels = 64;
 inline std::size_t motion_runs(int width) {
   return (static_cast<std::size_t>(width) + kMotionRunPixels - 1) / kMotionRunPixels;
 }
+// run(index, x0, x1) for each run [x0, x1) of a line of `pixels` pixels, the last one shorter where it ends the line.
+template <typename Run>
+void for_each_motion_run(std::size_t pixels, const Run& run) {
+  for (std::size_t x0 = 0; x0 < pixels; x0 += kMotionRunPixels) {
+    run(x0 / kMotionRunPixels, x0, std::min(pixels, x0 + kMotionRunPixels));
+  }
+}
 
 // The skip gates of one output line of a reduced frame that has a residual (DESIGN §7), from the line comparator
 // flags of its U source rows and the full frame's residual line flag.
