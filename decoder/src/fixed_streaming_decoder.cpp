@@ -253,11 +253,10 @@ class StreamingView {
   void add_tally_to(FrameTally& total) const { total += out_.tally; }
   void absorb(const FrameTally& bands) { out_.tally += bands; }
   void mark_all_pushed() { pushed_ = meta_.height; }
-  // Before the first line: the whole view's codes have passed their range check (decode, not push_line).
-  void mark_codes_checked() { codes_checked_ = true; }
-  // The lines pushed are rows of a whole view that outlives this one (decode, not push_line): the input rings hold
-  // them where they are.
-  void mark_input_in_place() { input_in_place_ = true; }
+  // The view is a whole frame given to decode (not lines pushed): its codes have all passed their range check before
+  // the first line (FixedDecoderCore::start_output may then take the held output's plane), and its rows outlive the
+  // view (the input rings hold them where they are).
+  void mark_whole_frame() { whole_frame_ = true; }
 
   DecodedFrame finish() {
     if (!started_) return core_.decode_lost(meta_, kWho);
@@ -296,7 +295,7 @@ class StreamingView {
     const Geometry& g = *g_;
     const StreamPlan plan = plan_for(g);
     full_ = meta_.parity == Parity::Full;
-    out_ = core_.start_output(meta_, eye, codes_checked_);
+    out_ = core_.start_output(meta_, eye, whole_frame_);
     out_.full = full_;
     core_.begin_lcd(out_, eye);
     const int full_samples = 3 * g.full.width;
@@ -340,7 +339,7 @@ class StreamingView {
     const int full_samples = 3 * g.full.width;
     if (codes == nullptr) {
       repeat_line(*delay_, y_in, full_samples);
-    } else if (input_in_place_) {
+    } else if (whole_frame_) {
       delay_->refer(y_in, codes);
     } else {
       std::copy(codes, codes + full_samples, delay_->write(y_in));
@@ -385,7 +384,7 @@ class StreamingView {
 
   void reduced_input(int k, const std::uint16_t* codes) {
     const int reduced_samples = 3 * g_->reduced.width;
-    if (codes != nullptr && input_in_place_) {
+    if (codes != nullptr && whole_frame_) {
       in_lines_->refer(k, codes);
     } else if (codes != nullptr) {
       std::copy(codes, codes + reduced_samples, in_lines_->write(k));
@@ -433,8 +432,7 @@ class StreamingView {
   int pushed_ = 0;
   int lost_lines_ = 0;
   bool started_ = false;  // the first intact line has arrived
-  bool codes_checked_ = false;  // every code checked before the first line (FixedDecoderCore::start_output)
-  bool input_in_place_ = false;  // mark_input_in_place
+  bool whole_frame_ = false;  // mark_whole_frame
   int first_ = 0;         // lines above it are read as it (see source_line)
   bool full_ = false;
   EyeState* eye_ = nullptr;
@@ -595,8 +593,7 @@ DecodedFrame FixedStreamingDecoder::decode_checked(const LinkFrame& frame, std::
   const bool whole = std::all_of(line_intact.begin(), line_intact.end(), [](std::uint8_t v) { return v != 0; });
   detail::check_link_frame(frame, core_->config().decoder.link, kWho, whole ? core_->config().threads : 1);
   begin_view(frame.meta);
-  view_->mark_codes_checked();
-  view_->mark_input_in_place();
+  view_->mark_whole_frame();
   if (whole && core_->config().threads > 1) return decode_in_bands(frame);
   for (int y = 0; y < frame.codes.rows; ++y) {
     take_line(frame.codes.ptr<std::uint16_t>(y), line_intact.empty() || line_intact[static_cast<std::size_t>(y)] != 0);
