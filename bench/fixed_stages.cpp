@@ -398,10 +398,12 @@ BENCHMARK_TEMPLATE(BM_LineOledDriveCodes, std::int32_t);
 BENCHMARK_TEMPLATE(BM_LineOledDriveCodes, Raw);
 
 // The LCD drive over a line after the eye's first frame, with its frame-store update (the stores are rewritten each
-// iteration from the same random history, outside the timing).
+// iteration from the same random history, outside the timing). Random rows v_{t-1}: every lookup far from the last.
+template <typename Linear>
 void BM_LineLcdDrive(benchmark::State& state) {
   FixedKernels kernels(config_of("lcd"));
-  const std::vector<Raw> wanted = random_linear(3 * kWidth, kernels.one(), 13);
+  const std::vector<Raw> wide = random_linear(3 * kWidth, kernels.one(), 13);
+  const std::vector<Linear> wanted(wide.begin(), wide.end());
   const std::vector<Raw> previous = random_linear(3 * kWidth, kernels.one(), 14);
   const std::vector<std::uint16_t> previous_codes = random_codes(3 * kWidth, kernels.max_output_code(), 15);
   std::vector<std::int32_t> store_linear(previous.size());
@@ -419,6 +421,7 @@ void BM_LineLcdDrive(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * 3 * kWidth);
 }
-BENCHMARK(BM_LineLcdDrive);
+BENCHMARK_TEMPLATE(BM_LineLcdDrive, std::int32_t);
+BENCHMARK_TEMPLATE(BM_LineLcdDrive, Raw);
 
 }  // namespace

@@ -928,6 +928,128 @@ inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const Fix
   return sample.code;
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// The LCD drive of a 32-bit line through LcdPlan::composed, in 32-bit lanes: per sample the composed word and the
+// row's ends (a second word lookup on the eye's first frame, for v_{t-1} from the held row). Vectors with a value
+// outside [-2^30, 2^30] (where the sum or 2 M^gamma - x_{t-1} could leave 32 bits) take lcd_scalar. Returns the
+// samples done (whole vectors); adds the unreachable ones to `unreachable`.
+std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                             std::uint8_t* previous_code, std::int32_t* previous_linear, bool held,
+                             std::uint16_t* codes, std::int64_t* shortfall, std::uint64_t& unreachable) {
+  const hn::ScalableTag<std::int32_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Rebind<float, decltype(d)> df;
+  const hn::Rebind<std::uint16_t, decltype(d)> d16;
+  const hn::Rebind<std::uint8_t, decltype(d)> d8;
+  const hn::Half<decltype(d)> dh;
+  const hn::Repartition<std::int64_t, decltype(d)> d64;
+  const std::size_t lanes = hn::Lanes(d);
+  // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
+  const std::uint32_t* composed = p.composed.data();
+  const std::uint64_t* ends = p.ends32.data();
+  const int m = p.composed_mantissa_bits;
+  const int fraction_shift = 23 - m;
+  const int offset_bits = p.composed_offset_bits;
+  const int target_shift = p.target_shift;
+  const std::int32_t buckets = p.composed_buckets;
+  const bool contributed_stored = p.contributed;
+  const auto zero = hn::Zero(d);
+  const auto top_c = hn::Set(d, std::int32_t{1} << p.target_input_bits);
+  const auto first_bucket = hn::Set(d, std::int32_t{126} << m);
+  const auto below_fraction = hn::Set(du, (std::uint32_t{1} << fraction_shift) - 1);
+  const auto offset_mask = hn::Set(du, (std::uint32_t{1} << offset_bits) - 1);
+  const auto row_words = hn::Set(d, buckets);
+  const auto held_row = hn::Set(d, static_cast<std::int32_t>(p.width * buckets));
+  const auto top = hn::Set(d, p.top);
+  const auto bound = hn::Set(d, std::int32_t{1} << 30);
+  auto unreachable_lanes = zero;
+  const auto load_previous = [&](std::size_t i, const auto x) {
+    return held ? x : hn::LoadU(d, previous_linear + i);
+  };
+  const auto previous_row = [&](std::size_t i) {
+    return hn::BitCast(d, hn::PromoteTo(du, hn::LoadU(d8, previous_code + i)));
+  };
+  // The code from a composed word and c's bits above its bucket's lower end.
+  const auto code_of = [&](const auto word, const auto above_lo) {
+    return hn::BitCast(d, hn::Add(hn::ShiftRightSame(word, offset_bits),
+                                  hn::IfThenZeroElse(hn::Lt(above_lo, hn::And(word, offset_mask)), hn::Set(du, 1u))));
+  };
+  HWY_ALIGN std::uint32_t words[kPassChunk];
+  HWY_ALIGN std::uint32_t above_lo[kPassChunk];
+  HWY_ALIGN std::int32_t bucket_of[kPassChunk];
+  HWY_ALIGN std::int32_t rows[kPassChunk];
+  HWY_ALIGN std::uint64_t row_ends[kPassChunk];
+  std::array<bool, kPassChunk> by_scalar{};
+  std::size_t s = 0;
+  while (s + lanes <= n) {
+    const std::size_t count = pass_chunk(n - s, lanes);
+    // c's bucket and the bits above its lower end; the word's place in v_{t-1}'s row (the held row first).
+    for (std::size_t i = 0; i < count; i += lanes) {
+      const auto x = hn::LoadU(d, wanted + s + i);
+      const auto x_previous = load_previous(s + i, x);
+      const auto outside = [&](const auto v) { return hn::Or(hn::Lt(v, hn::Neg(bound)), hn::Gt(v, bound)); };
+      by_scalar[i] = !hn::AllFalse(d, hn::Or(outside(x), outside(x_previous)));
+      const auto sum = hn::Add(x, x_previous);
+      const auto c = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), target_shift), top_c);
+      const auto bits = hn::BitCast(du, hn::ConvertTo(df, c));
+      const auto bucket = hn::Max(hn::Sub(hn::BitCast(d, hn::ShiftRightSame(bits, fraction_shift)), first_bucket), zero);
+      const auto lo = hn::ConvertTo(d, hn::BitCast(df, hn::AndNot(below_fraction, bits)));
+      hn::Store(hn::BitCast(du, hn::Sub(c, lo)), du, above_lo + i);
+      hn::Store(bucket, d, bucket_of + i);
+      const auto row = held ? held_row : hn::Mul(previous_row(s + i), row_words);
+      hn::Store(hn::BitCast(du, hn::Add(bucket, row)), du, words + i);
+    }
+    look_up(composed, words, count);
+    if (held) {  // v_{t-1} from the held row, then the word of its row
+      for (std::size_t i = 0; i < count; i += lanes) {
+        const auto j = code_of(hn::Load(du, words + i), hn::Load(du, above_lo + i));
+        hn::Store(j, d, rows + i);
+        hn::Store(hn::BitCast(du, hn::Add(hn::Load(d, bucket_of + i), hn::Mul(j, row_words))), du, words + i);
+      }
+      look_up(composed, words, count);
+      look_up_into(ends, rows, count, row_ends);
+    } else {
+      look_up_into(ends, previous_code + s, count, row_ends);
+    }
+    for (std::size_t i = 0; i < count; i += lanes) {
+      if (by_scalar[i]) {
+        for (std::size_t k = s + i; k < s + i + lanes; ++k) {
+          codes[k] = lcd_scalar(wanted[k], p, kernels, previous_code[k], previous_linear[k], held,
+                                shortfall != nullptr ? shortfall + k : nullptr, unreachable);
+        }
+        continue;
+      }
+      const auto x = hn::LoadU(d, wanted + s + i);
+      const auto x_previous = load_previous(s + i, x);
+      const auto sum = hn::Add(x, x_previous);
+      const auto code = code_of(hn::Load(du, words + i), hn::Load(du, above_lo + i));
+      hn::Vec<decltype(du)> dark_bits, bright_bits;
+      hn::LoadInterleaved2(du, reinterpret_cast<const std::uint32_t*>(row_ends + i), dark_bits, bright_bits);
+      const auto end_dark = hn::BitCast(d, dark_bits);
+      const auto end_bright = hn::BitCast(d, bright_bits);
+      const auto below = hn::Lt(sum, end_dark);
+      const auto above = hn::Gt(sum, end_bright);
+      const auto clamped = hn::Or(below, above);
+      const auto drive = hn::IfThenElse(clamped, hn::IfThenElseZero(above, top), code);
+      const auto contributed =
+          hn::IfThenElse(clamped, hn::Sub(hn::IfThenElse(above, end_bright, end_dark), x_previous), x);
+      unreachable_lanes = CountInto(d, unreachable_lanes, clamped);
+      if (shortfall != nullptr) {
+        const auto gap = hn::Sub(x, contributed);
+        hn::StoreU(hn::PromoteTo(d64, hn::LowerHalf(dh, gap)), d64, shortfall + s + i);
+        hn::StoreU(hn::PromoteTo(d64, hn::UpperHalf(dh, gap)), d64, shortfall + s + i + lanes / 2);
+      }
+      hn::StoreU(hn::DemoteTo(d16, drive), d16, codes + s + i);
+      hn::StoreU(hn::DemoteTo(d8, drive), d8, previous_code + s + i);
+      hn::StoreU(contributed_stored ? contributed : x, d, previous_linear + s + i);
+    }
+    s += count;
+  }
+  unreachable += Total(d, unreachable_lanes);
+  return s;
+}
+#endif
+
 template <typename Wanted>
 std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
                          std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,
@@ -935,6 +1057,10 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
   std::uint64_t unreachable = 0;
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
+  if constexpr (sizeof(Wanted) == 4) {
+    if (!p.composed.empty()) s = LcdDriveComposed(wanted, n, p, kernels, previous_code, previous_linear, held, codes,
+                                                  shortfall, unreachable);
+  }
   const hn::ScalableTag<std::int64_t> d;
   const hn::RebindToUnsigned<decltype(d)> du;
   const hn::Repartition<std::uint32_t, decltype(du)> du32;
@@ -1695,6 +1821,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     if (fits) {
       l.target_packed = std::move(*packed);
       lcd_search_index(l);
+      lcd_composed_index(l, target);
       plans.lcd = std::move(l);
     }
   }
@@ -1714,6 +1841,28 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
 
 namespace {
 
+// The values of bucket b of a table addressed by a value's float (DrivePlan::packed32, LcdPlan::composed: the float's
+// bits shifted right by 23 - m, less 126 << m, 0 for the value 0): [lo, lo + width). Bucket b >= 2^m: leading one
+// e = (b >> m) - 1, the m fraction bits f = b mod 2^m; below e = m a bucket is one value, and exists where f's low
+// m - e bits are 0. Bucket 0 is the value 0; buckets 1 .. 2^m - 1 are never addressed. False for a bucket no value
+// addresses.
+bool float_bucket(std::int32_t b, int m, std::int64_t& lo, std::int64_t& width) {
+  lo = 0;
+  width = 1;
+  if (b == 0) return true;
+  if (b < (1 << m)) return false;
+  const int e = (b >> m) - 1;
+  const std::int64_t f = b & ((1 << m) - 1);
+  if (e >= m) {
+    lo = ((std::int64_t{1} << m) + f) << (e - m);
+    width = std::int64_t{1} << (e - m);
+    return true;
+  }
+  if ((f & ((std::int64_t{1} << (m - e)) - 1)) != 0) return false;
+  lo = (std::int64_t{1} << e) + (f >> (m - e));
+  return true;
+}
+
 // DrivePlan::packed32 for a plan whose 32-bit tables are built, where every channel's every bucket holds at most one
 // threshold.
 void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, DrivePlan& d) {
@@ -1726,28 +1875,15 @@ void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, D
     code_bits = std::max(code_bits, static_cast<int>(std::bit_width(index->padded().size())));
   }
   if (value_bits > 30 || m > 16 || offset_bits < 1 || offset_bits + code_bits > 32) return;
-  // Bucket b >= 2^m: leading one e = (b >> m) - 1, the m fraction bits f = b mod 2^m; below e = m a bucket is one
-  // value, and exists where f's low m - e bits are 0. Bucket 0 is x = 0; buckets 1 .. 2^m - 1 are never addressed.
   const std::int32_t buckets = (value_bits + 1) << m;
   std::vector<std::uint32_t> packed(3 * static_cast<std::size_t>(buckets), 0);
   for (std::size_t ch = 0; ch < 3; ++ch) {
     const ThresholdIndex& index = *channels[ch];
     const std::vector<std::int64_t>& padded = index.padded();
     for (std::int32_t b = 0; b < buckets; ++b) {
-      if (b > 0 && b < (1 << m)) continue;
       std::int64_t lo = 0;
       std::int64_t width = 1;
-      if (b > 0) {
-        const int e = (b >> m) - 1;
-        const std::int64_t f = b & ((1 << m) - 1);
-        if (e >= m) {
-          lo = ((std::int64_t{1} << m) + f) << (e - m);
-          width = std::int64_t{1} << (e - m);
-        } else {
-          if ((f & ((std::int64_t{1} << (m - e)) - 1)) != 0) continue;
-          lo = (std::int64_t{1} << e) + (f >> (m - e));
-        }
-      }
+      if (!float_bucket(b, m, lo, width)) continue;
       const std::uint16_t k = index.search(lo);
       const std::int64_t next = padded[std::size_t{k} + 1];  // above lo (k is lo's code); the padding no x reaches
       if (next <= lo || index.search(lo + width - 1) > k + 1) return;  // two thresholds inside: not one lookup
@@ -1765,22 +1901,34 @@ void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, D
 
 }  // namespace
 
-void lcd_search_index(LcdPlan& plan) {
-  plan.index.clear();
+namespace {
+
+// Each row's merge thresholds in the target's units (LcdPlan::index), rows of plan.top: U_k = ceil(merge[r][k] /
+// scale), nondecreasing in k and every one in [1, one]; empty where a row's are not.
+std::vector<std::int64_t> lcd_thresholds(const LcdPlan& plan) {
   const std::int64_t rows = plan.width + 1;
-  const std::int64_t one = plan.one;
   const auto scale = static_cast<std::int64_t>(plan.scale);
-  if (scale <= 0 || plan.top < 1 || plan.merge.size() < static_cast<std::size_t>(rows * plan.width)) return;
-  // Each row's thresholds in the target's units, increasing; every one in [1, one].
+  if (scale <= 0 || plan.top < 1 || plan.merge.size() < static_cast<std::size_t>(rows * plan.width)) return {};
   std::vector<std::int64_t> thresholds(static_cast<std::size_t>(rows * plan.top));
   for (std::int64_t r = 0; r < rows; ++r) {
     for (std::int64_t k = 1; k <= plan.top; ++k) {
       const std::int64_t merge = plan.merge[static_cast<std::size_t>(r * plan.width + k)];
       const std::int64_t u = merge <= 0 ? 0 : (merge + scale - 1) / scale;
-      if (u < 1 || u > one || (k > 1 && u < thresholds[static_cast<std::size_t>(r * plan.top + k - 2)])) return;
+      if (u < 1 || u > plan.one || (k > 1 && u < thresholds[static_cast<std::size_t>(r * plan.top + k - 2)])) return {};
       thresholds[static_cast<std::size_t>(r * plan.top + k - 1)] = u;
     }
   }
+  return thresholds;
+}
+
+}  // namespace
+
+void lcd_search_index(LcdPlan& plan) {
+  plan.index.clear();
+  const std::int64_t rows = plan.width + 1;
+  const std::int64_t one = plan.one;
+  const std::vector<std::int64_t> thresholds = lcd_thresholds(plan);
+  if (thresholds.empty()) return;
   const int F = plan.linear_frac_bits;
   const int code_bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(plan.top)));
   for (int shift = F - 8; shift >= std::max(1, F - 14); --shift) {
@@ -1810,6 +1958,93 @@ void lcd_search_index(LcdPlan& plan) {
     plan.index_shift = shift;
     plan.index_offset_bits = offset_bits;
     plan.index_buckets = buckets;
+    return;
+  }
+}
+
+void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target) {
+  plan.composed.clear();
+  plan.ends32.clear();
+  const int input_bits = plan.target_input_bits;
+  const std::int64_t rows = plan.width + 1;
+  if (input_bits < 1 || input_bits > 24 || plan.target_shift < 0 || plan.linear_frac_bits > 28 ||
+      plan.ends.size() != static_cast<std::size_t>(2 * plan.width) || target.shape().input_bits != input_bits) {
+    return;
+  }
+  const std::vector<std::int64_t> thresholds = lcd_thresholds(plan);
+  if (thresholds.empty()) return;
+  // The target of c, as LcdDriveOf and FixedKernels::lcd_drive take it: 0 for a sum at or below 0 (so the ROM's first
+  // word must be 0, which a sum in (0, 2^target_shift) reads), the ROM below 2^input_bits, one at it. It rises with c
+  // where the ROM's words do: within a segment the interpolation's rounding is monotone in the weight, and a segment
+  // ends where the next begins.
+  const std::vector<std::int64_t>& rom = target.rom();
+  if (rom.empty() || rom.front() != 0 || !std::is_sorted(rom.begin(), rom.end())) return;
+  const std::int64_t top_c = std::int64_t{1} << input_bits;
+  const auto target_of = [&](std::int64_t c) {
+    return c >= top_c ? plan.one : target.evaluate_raw(static_cast<std::uint32_t>(c));
+  };
+  if (target_of(top_c - 1) > plan.one) return;
+  // C_k per row: the least c with target(c) >= U_k (U_k <= one = target(2^input_bits), so there is one).
+  std::vector<std::int64_t> least_c(thresholds.size());
+  for (std::int64_t r = 0; r < rows; ++r) {
+    std::int64_t from = 0;
+    for (std::int64_t k = 0; k < plan.top; ++k) {
+      const std::size_t at = static_cast<std::size_t>(r * plan.top + k);
+      std::int64_t lo = from;
+      std::int64_t hi = top_c;
+      while (lo < hi) {
+        const std::int64_t mid = lo + (hi - lo) / 2;
+        if (target_of(mid) >= thresholds[at]) {
+          hi = mid;
+        } else {
+          lo = mid + 1;
+        }
+      }
+      least_c[at] = from = lo;
+    }
+  }
+  // The unreachable ends of the sums, in 32 bits.
+  std::vector<std::uint64_t> ends(static_cast<std::size_t>(plan.width));
+  for (std::size_t v = 0; v < ends.size(); ++v) {
+    const std::int64_t dark = 2 * plan.ends[2 * v];
+    const std::int64_t bright = 2 * plan.ends[2 * v + 1];
+    if (dark < 0 || bright < 0 || dark > INT32_MAX || bright > INT32_MAX) return;
+    ends[v] = static_cast<std::uint64_t>(dark) | (static_cast<std::uint64_t>(bright) << 32);
+  }
+  const int code_bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(plan.top)));
+  for (int m = 6; m <= 10; ++m) {
+    const int offset_bits = input_bits - m + 1;  // a bucket is at most 2^(input_bits - m) wide
+    const std::int32_t buckets = (input_bits + 2) << m;
+    if (offset_bits < 1 || offset_bits + code_bits > 32 ||
+        static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets) * sizeof(std::uint32_t) >
+            LcdPlan::kMaxComposedBytes) {
+      continue;
+    }
+    std::vector<std::uint32_t> composed(static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets), 0);
+    bool fits = true;
+    for (std::int64_t r = 0; r < rows && fits; ++r) {
+      const std::int64_t* c_k = least_c.data() + r * plan.top;
+      std::int64_t code = 0;  // C_k at or below the bucket's lower end
+      for (std::int32_t b = 0; b < buckets; ++b) {
+        std::int64_t lo = 0;
+        std::int64_t width = 1;
+        if (!float_bucket(b, m, lo, width) || lo > top_c) continue;
+        while (code < plan.top && c_k[code] <= lo) ++code;
+        if (code + 1 < plan.top && c_k[code + 1] < lo + width) {  // two inside: too coarse
+          fits = false;
+          break;
+        }
+        const std::int64_t next = code < plan.top ? std::min(c_k[code] - lo, width) : width;
+        composed[static_cast<std::size_t>(r * buckets + b)] =
+            (static_cast<std::uint32_t>(code) << offset_bits) | static_cast<std::uint32_t>(next);
+      }
+    }
+    if (!fits) continue;
+    plan.composed = std::move(composed);
+    plan.composed_mantissa_bits = m;
+    plan.composed_offset_bits = offset_bits;
+    plan.composed_buckets = buckets;
+    plan.ends32 = std::move(ends);
     return;
   }
 }

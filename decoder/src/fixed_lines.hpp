@@ -12,6 +12,10 @@
 #include <optional>
 #include <vector>
 
+namespace trm::fx {
+class InterpolatedLut;
+}  // namespace trm::fx
+
 namespace trm::fixed_detail {
 
 class FixedKernels;
@@ -221,11 +225,31 @@ struct LcdPlan {
   int index_shift = 0;
   int index_offset_bits = 0;
   std::int64_t index_buckets = 0;  // per row: (one >> s) + 1
+  // The target ROM and the search in one lookup (lcd_composed_index; a simulation table, as FixedLinePlans::
+  // drive_of_node: the modelled hardware runs both). The code depends on the sum x_t + x_{t-1} only through the ROM's
+  // input c = min(max(sum, 0) >> target_shift, 2^target_input_bits), c = 2^target_input_bits standing for the target
+  // one: per row r, C_k = the least c whose target reaches U_k is increasing in k, and the code is the number of
+  // C_k at or below c. Word [r composed_buckets + b] holds, for bucket b of c addressed by c's float with
+  // composed_mantissa_bits (as DrivePlan::packed32), the code at the bucket's lower end shifted left by
+  // composed_offset_bits, above the offset of the row's next C_k from it (the bucket's width where that lies past
+  // it). Built where the ROM's input fits a float's 24 bits, the target rises with c, every bucket of every row holds
+  // at most one C_k and the table is at most kMaxComposedBytes; empty otherwise.
+  static constexpr std::size_t kMaxComposedBytes = std::size_t{16} << 20;
+  std::vector<std::uint32_t> composed;
+  int composed_mantissa_bits = 0;
+  int composed_offset_bits = 0;
+  std::int32_t composed_buckets = 0;
+  // Per v_{t-1}: 2 M(0, v_{t-1})^gamma in the low 32 bits, 2 M(1, v_{t-1})^gamma in the high, the
+  // sums' unreachable ends for the composed kernel's 32-bit lanes (both below 2^31 wherever composed is built).
+  std::vector<std::uint64_t> ends32;
 };
 
 // The per-row target index of an LCD plan (LcdPlan::index): the coarsest bucket width that holds at most one
 // threshold, from 2^(F-8) down to 2^(F-14) targets; none where no width does.
 void lcd_search_index(LcdPlan& plan);
+// LcdPlan::composed and ends32 of a plan whose target ROM is `target`: the coarsest float addressing, from 2^6 to
+// 2^10 buckets per octave, that fits; none where none does.
+void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target);
 
 // What the line kernels need from a configuration, or nothing where its formats do not fit their lanes.
 struct FixedLinePlans {

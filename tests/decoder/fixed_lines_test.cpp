@@ -797,6 +797,9 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
       previous_linear[s] = static_cast<std::int32_t>(s % 5 == 0 ? -(linear(random) / 8) : linear(random));
       if (s % 11 == 0) wanted[s] = previous_linear[s] = 0;
       if (s % 13 == 0) wanted[s] = one, previous_linear[s] = static_cast<std::int32_t>(one);
+      // Now and then a stored x_{t-1} past 2^30 either way (a long run of contributed shortfalls): there the sum and
+      // 2 M^gamma - x_{t-1} leave the composed kernel's 32-bit lanes.
+      if (s % 997 == 0) previous_linear[s] = s % 2 == 0 ? INT32_MIN + 1 : (std::int32_t{1} << 30) + 1;
       previous_code[s] = static_cast<std::uint8_t>(random() % 256);
     }
     std::vector<std::uint16_t> expected_codes(kSamples);
@@ -815,17 +818,21 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
     }
     EXPECT_GT(expected_unreachable, 0u) << "the operands reach the unreachable ends";
     ASSERT_FALSE(plan->index.empty()) << "the per-row index is built";
-    fixed_detail::LcdPlan binary = *plan;  // the binary search of the merge table, where no index is built
+    ASSERT_FALSE(plan->composed.empty()) << "the composed table is built";
+    fixed_detail::LcdPlan indexed = *plan;  // the per-row index, where no composed table is built
+    indexed.composed.clear();
+    fixed_detail::LcdPlan binary = indexed;  // the binary search of the merge table, where neither is
     binary.index.clear();
     const std::vector<std::int32_t> wanted32(wanted.begin(), wanted.end());  // the 32-bit line (narrow_lines)
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
      for (const bool narrow : {false, true}) {
-      for (const fixed_detail::LcdPlan* searched : {&*plan, static_cast<const fixed_detail::LcdPlan*>(&binary)}) {
+      for (const fixed_detail::LcdPlan* searched : {&*plan, static_cast<const fixed_detail::LcdPlan*>(&indexed),
+                                                    static_cast<const fixed_detail::LcdPlan*>(&binary)}) {
         const TargetMock mock(target);
         const std::string where = std::string(hwy::TargetName(target)) +
                                   (history == LcdHistory::Contributed ? " contributed" : " wanted") + " F=" +
                                   std::to_string(linear_frac_bits) + (held ? " held" : "") +
-                                  (searched == &binary ? " binary search" : " index") +
+                                  (searched == &binary ? " binary search" : searched == &indexed ? " index" : " composed") +
                                   (narrow ? " 32-bit line" : " 64-bit line");
         std::vector<std::uint8_t> store_code(previous_code);
         std::vector<std::uint16_t> codes(kSamples);
@@ -845,6 +852,69 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
         }
       }
      }
+    }
+  }
+}
+
+// The LCD drive through the composed table (LcdPlan::composed) against FixedKernels::lcd_drive at every code step of
+// every row v_{t-1}: the least sum x_t + x_{t-1} whose stage code reaches k, found by bisection of the stage function
+// itself, and the sums one below and one above it, on every instruction set; at the default F and at F = 20.
+TEST(FixedLines, LcdComposedTableGivesTheStageCodesAtEveryStep) {
+  for (const int linear_frac_bits : {28, 20}) {
+    FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
+    config.linear_frac_bits = linear_frac_bits;
+    config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
+    const fixed_detail::FixedKernels kernels(config);
+    ASSERT_TRUE(kernels.line_plans().lcd.has_value());
+    const fixed_detail::LcdPlan& plan = *kernels.line_plans().lcd;
+    ASSERT_FALSE(plan.composed.empty()) << "F = " << linear_frac_bits;
+    const std::int64_t one = kernels.one();
+    const auto stage_code = [&](std::int64_t sum, int row) {
+      const std::int64_t wanted = sum / 2;
+      return kernels.lcd_drive(wanted, sum - wanted, static_cast<std::uint16_t>(row), false, false).code;
+    };
+    std::vector<std::int32_t> wanted;
+    std::vector<std::int32_t> previous_linear;
+    std::vector<std::uint8_t> previous_code;
+    std::size_t steps = 0;
+    for (int row = 0; row <= plan.top; ++row) {
+      for (int k = 1; k <= plan.top; ++k) {
+        if (stage_code(2 * one, row) < k) continue;  // the row never reaches k
+        std::int64_t lo = 0;
+        std::int64_t hi = 2 * one;
+        while (lo < hi) {
+          const std::int64_t mid = lo + (hi - lo) / 2;
+          if (stage_code(mid, row) >= k) {
+            hi = mid;
+          } else {
+            lo = mid + 1;
+          }
+        }
+        ++steps;
+        for (const std::int64_t sum : {lo - 1, lo, lo + 1}) {
+          if (sum < 0 || sum > 2 * one) continue;
+          wanted.push_back(static_cast<std::int32_t>(sum / 2));
+          previous_linear.push_back(static_cast<std::int32_t>(sum - sum / 2));
+          previous_code.push_back(static_cast<std::uint8_t>(row));
+        }
+      }
+    }
+    EXPECT_GT(steps, 255u * 200u) << "most rows step through most codes";
+    std::vector<std::uint16_t> expected(wanted.size());
+    for (std::size_t s = 0; s < wanted.size(); ++s) {
+      expected[s] = kernels.lcd_drive(wanted[s], previous_linear[s], previous_code[s], false, false).code;
+    }
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      std::vector<std::uint8_t> store_code(previous_code);
+      std::vector<std::int32_t> store_linear(previous_linear);
+      std::vector<std::uint16_t> codes(wanted.size());
+      fixed_detail::lines::lcd_drive(wanted.data(), wanted.size(), plan, kernels, store_code.data(),
+                                     store_linear.data(), false, codes.data(), nullptr);
+      for (std::size_t s = 0; s < wanted.size(); ++s) {
+        ASSERT_EQ(codes[s], expected[s]) << hwy::TargetName(target) << " F=" << linear_frac_bits << " row "
+                                         << int{previous_code[s]} << " sum " << wanted[s] + previous_linear[s];
+      }
     }
   }
 }
