@@ -121,14 +121,20 @@ class FixedKernels {
   // D, vertical half, and Q_b: d = round(sum_j w_j h_j) where rows[j] is the line buffer row of tap j, a link code;
   // an exact half-code tie rounds up, as the encoder's quantise_reduced does. Linear space: the sum rounded to uQ1.P
   // and re-encoded through the threshold ROM (thresholds from quantise_reduced).
-  std::uint16_t gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const;
+  template <typename Line>
+  std::uint16_t gaussian_vertical(const Line* const* rows, const PolyphaseTaps& taps, int sample) const;
   // D's two halves over a line, as the schedules run them: out[3k + ch] = gaussian_horizontal(codes_row,
   // g.gauss_cols[k], ch) for every reduced column k; out[i] = gaussian_vertical(rows, taps, i) for i < samples. A
   // grey line (every pixel R = G = B, the chroma skip) computes channel 0 and copies it. The same bits as the
-  // per-sample functions (one accumulation per sample, all three channels in one pass over the taps).
-  void gaussian_horizontal_line(const std::uint16_t* codes_row, const Geometry& g, Raw* out, bool grey) const;
-  void gaussian_vertical_row(const Raw* const* rows, const PolyphaseTaps& taps, int samples, std::uint16_t* out,
+  // per-sample functions (one accumulation per sample, all three channels in one pass over the taps). The line
+  // buffer's words are Raw, or 32 bits where narrow_gaussian_lines says they hold every value.
+  template <typename Line>
+  void gaussian_horizontal_line(const std::uint16_t* codes_row, const Geometry& g, Line* out, bool grey) const;
+  template <typename Line>
+  void gaussian_vertical_row(const Line* const* rows, const PolyphaseTaps& taps, int samples, std::uint16_t* out,
                              bool grey) const;
+  // D's line buffer in 32-bit words: the encoded space with the line kernels' plan (every horizontal sum below 2^32).
+  bool narrow_gaussian_lines() const { return !linear_space_ && line_plans_.gaussian.has_value(); }
   // Linear space: the link code the encoder gives linear value x (uQ1.P): the largest k with x >= T_k.
   std::uint16_t encode_linear(Raw x) const;
 

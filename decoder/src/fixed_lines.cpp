@@ -647,8 +647,10 @@ std::uint64_t Compensate32(const std::uint16_t* codes, const std::int32_t* low, 
   return CompensateOf(codes, low, n, plans, shown, rho);
 }
 
-void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
-                     std::int64_t* out) {
+// Into 64-bit or 32-bit line words (the sums are below 2^32 either way: GaussianPlan).
+template <typename Line>
+void GaussianColumnsOf(const std::uint16_t* row, [[maybe_unused]] std::size_t row_samples,
+                       const GaussianColumnsPlan& plan, int shift, Line* out) {
   const std::size_t n = plan.samples;
   const auto scalar = [&](std::size_t s) {
     std::uint32_t acc = 0;
@@ -658,7 +660,7 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
     const std::uint32_t kept = acc >> shift;
     const std::uint32_t first = (acc >> (shift - 1)) & 1u;
     const std::uint32_t rest = acc & ((std::uint32_t{1} << (shift - 1)) - 1u);
-    return static_cast<std::int64_t>(kept + (first & ((rest != 0 ? 1u : 0u) | (kept & 1u))));
+    return static_cast<Line>(kept + (first & ((rest != 0 ? 1u : 0u) | (kept & 1u))));
   };
   std::size_t s = 0;
 #if HWY_TARGET != HWY_SCALAR
@@ -764,8 +766,12 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
       const auto r0 = rounded(acc0);
       const auto r1 = rounded(acc1);
       const auto r2 = rounded(acc2);
-      hn::StoreInterleaved3(widened_low(r0), widened_low(r1), widened_low(r2), d64, out + 3 * k);
-      hn::StoreInterleaved3(widened_high(r0), widened_high(r1), widened_high(r2), d64, out + 3 * (k + half));
+      if constexpr (sizeof(Line) == 4) {
+        hn::StoreInterleaved3(r0, r1, r2, du, reinterpret_cast<std::uint32_t*>(out) + 3 * k);
+      } else {
+        hn::StoreInterleaved3(widened_low(r0), widened_low(r1), widened_low(r2), d64, out + 3 * k);
+        hn::StoreInterleaved3(widened_high(r0), widened_high(r1), widened_high(r2), d64, out + 3 * (k + half));
+      }
     }
     s = 3 * k;
   } else {
@@ -782,16 +788,35 @@ void GaussianColumns(const std::uint16_t* row, [[maybe_unused]] std::size_t row_
         acc = hn::Add(acc, hn::Mul(hn::LoadU(du, plan.weight.data() + t * n + s), code));
       }
       const auto r = rounded(acc);
-      hn::StoreU(widened_low(r), d64, out + s);
-      hn::StoreU(widened_high(r), d64, out + s + lanes / 2);
+      if constexpr (sizeof(Line) == 4) {
+        hn::StoreU(r, du, reinterpret_cast<std::uint32_t*>(out) + s);
+      } else {
+        hn::StoreU(widened_low(r), d64, out + s);
+        hn::StoreU(widened_high(r), d64, out + s + lanes / 2);
+      }
     }
   }
 #endif
   for (; s < n; ++s) out[s] = scalar(s);
 }
 
-void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
-                  int shift, [[maybe_unused]] bool fold, std::uint16_t* out) {
+#if HWY_TARGET != HWY_SCALAR
+// A 64-bit line's words (the 32-bit instantiation's body never reaches this: its vectors are whole 32-bit words).
+template <class D, typename Line>
+HWY_INLINE hn::Vec<D> LoadLine(D d, const Line* p) {
+  if constexpr (sizeof(Line) == 8) {
+    return hn::LoadU(d, p);
+  } else {
+    return hn::PromoteTo(d, hn::LoadU(hn::Rebind<std::int32_t, D>(), reinterpret_cast<const std::int32_t*>(p)));
+  }
+}
+#endif
+
+// From 64-bit or 32-bit line words. On 32-bit words a vector holds twice the samples: the products of its even and
+// odd lanes are summed apart in 64-bit lanes and the two results' 16 bits put back in order.
+template <typename Line>
+void GaussianRowsOf(const Line* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                    int shift, [[maybe_unused]] bool fold, std::uint16_t* out) {
   std::size_t i = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<std::int64_t> d;
@@ -805,16 +830,43 @@ void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, 
   bool symmetric = fold;
   for (std::size_t j = 0; j < count / 2 && symmetric; ++j) symmetric = weight[j] == weight[count - 1 - j];
   const std::size_t folded = symmetric ? count / 2 : 0;
-  for (; i + lanes <= n; i += lanes) {
+  if constexpr (sizeof(Line) == 4) {
+    const std::size_t wide = hn::Lanes(du32);
+    const auto* rows32 = reinterpret_cast<const std::uint32_t* const*>(rows);
+    for (; i + wide <= n; i += wide) {
+      auto even = hn::Zero(du);
+      auto odd = hn::Zero(du);
+      const auto add_products = [&](const auto w, const auto samples) {
+        even = hn::Add(even, hn::MulEven(w, samples));
+        odd = hn::Add(odd, hn::MulEven(w, hn::BitCast(du32, hn::ShiftRight<32>(hn::BitCast(du, samples)))));
+      };
+      for (std::size_t j = 0; j < folded; ++j) {
+        add_products(hn::Set(du32, weight[j]),
+                     hn::Add(hn::LoadU(du32, rows32[j] + i), hn::LoadU(du32, rows32[count - 1 - j] + i)));
+      }
+      for (std::size_t j = folded; j < count - folded; ++j) {
+        add_products(hn::Set(du32, weight[j]), hn::LoadU(du32, rows32[j] + i));
+      }
+      // The even sample's 16 bits in a 64-bit lane's low half-word, the odd one's above it (each result truncated to
+      // 16 bits, as the 64-bit lines' stores truncate it).
+      const auto low = hn::And(hn::ShiftRightSame(hn::Add(even, half), shift), hn::Set(du, std::uint64_t{0xffff}));
+      const auto high = hn::ShiftRightSame(hn::Add(odd, half), shift);
+      const hn::Rebind<std::uint32_t, decltype(du)> du32_half;
+      const hn::Repartition<std::uint16_t, decltype(du32_half)> d16_pairs;
+      const auto pairs = hn::TruncateTo(du32_half, hn::Or(low, hn::ShiftLeft<16>(high)));
+      hn::StoreU(hn::BitCast(d16_pairs, pairs), d16_pairs, out + i);
+    }
+  }
+  for (; sizeof(Line) == 8 && i + lanes <= n; i += lanes) {
     auto acc = hn::Zero(du);
     for (std::size_t j = 0; j < folded; ++j) {
       const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
-      const auto pair = hn::Add(hn::LoadU(d, rows[j] + i), hn::LoadU(d, rows[count - 1 - j] + i));
+      const auto pair = hn::Add(LoadLine(d, rows[j] + i), LoadLine(d, rows[count - 1 - j] + i));
       acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, pair)));
     }
     for (std::size_t j = folded; j < count - folded; ++j) {
       const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
-      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, hn::LoadU(d, rows[j] + i))));
+      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, LoadLine(d, rows[j] + i))));
     }
     hn::StoreU(hn::TruncateTo(d16, hn::ShiftRightSame(hn::Add(acc, half), shift)), d16, out + i);
   }
@@ -824,6 +876,23 @@ void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, 
     for (std::size_t j = 0; j < count; ++j) acc += std::uint64_t{weight[j]} * static_cast<std::uint64_t>(rows[j][i]);
     out[i] = static_cast<std::uint16_t>((acc + (std::uint64_t{1} << (shift - 1))) >> shift);
   }
+}
+
+void GaussianColumns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                     std::int64_t* out) {
+  GaussianColumnsOf(row, row_samples, plan, shift, out);
+}
+void GaussianColumns32(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                       std::uint32_t* out) {
+  GaussianColumnsOf(row, row_samples, plan, shift, out);
+}
+void GaussianRows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                  int shift, bool fold, std::uint16_t* out) {
+  GaussianRowsOf(rows, weight, count, n, shift, fold, out);
+}
+void GaussianRows32(const std::uint32_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                    int shift, bool fold, std::uint16_t* out) {
+  GaussianRowsOf(rows, weight, count, n, shift, fold, out);
 }
 
 #if HWY_TARGET != HWY_SCALAR
@@ -2201,6 +2270,8 @@ HWY_EXPORT(DriveCodes);
 HWY_EXPORT(Compensate);
 HWY_EXPORT(GaussianColumns);
 HWY_EXPORT(GaussianRows);
+HWY_EXPORT(GaussianColumns32);
+HWY_EXPORT(GaussianRows32);
 HWY_EXPORT(LcdDrive);
 HWY_EXPORT(LcdSearch);
 HWY_EXPORT(MotionWeights);
@@ -2257,6 +2328,14 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
                    int shift, bool fold, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(GaussianRows)(rows, weight, count, n, shift, fold, out);
+}
+void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan, int shift,
+                      std::uint32_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianColumns32)(row, row_samples, plan, shift, out);
+}
+void gaussian_rows(const std::uint32_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                   int shift, bool fold, std::uint16_t* out) {
+  HWY_DYNAMIC_DISPATCH(GaussianRows32)(rows, weight, count, n, shift, fold, out);
 }
 void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& plan,
                 std::uint16_t* codes) {

@@ -310,6 +310,11 @@ void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const G
 // fold: rows[j][i] + rows[k][i] < 2^32 too, so that symmetric weights may be summed in pairs (GaussianPlan::fold_rows).
 void gaussian_rows(const std::int64_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
                    int shift, bool fold, std::uint16_t* out);
+// The same on 32-bit line words (every D sum of a GaussianPlan fits them): half the line buffers' bytes.
+void gaussian_columns(const std::uint16_t* row, std::size_t row_samples, const GaussianColumnsPlan& plan,
+                      int shift, std::uint32_t* out);
+void gaussian_rows(const std::uint32_t* const* rows, const std::uint32_t* weight, std::size_t count, std::size_t n,
+                   int shift, bool fold, std::uint16_t* out);
 // The LCD drive of n samples of one line: codes[s] and, where shortfall is not null, shortfall[s] as
 // FixedKernels::lcd_drive(wanted[s], previous_linear[s], previous_code[s], held) gives them, and the frame stores
 // previous_code / previous_linear replaced as FixedDecoderCore::emit replaces them (held: the eye's first frame,

@@ -25,22 +25,26 @@ Raw FixedKernels::gaussian_horizontal(const std::uint16_t* codes_row, const Poly
   return fx::rounded_shift(acc, shift, fx::Quant::RndConv);
 }
 
-std::uint16_t FixedKernels::gaussian_vertical(const Raw* const* rows, const PolyphaseTaps& taps, int sample) const {
+template <typename Line>
+std::uint16_t FixedKernels::gaussian_vertical(const Line* const* rows, const PolyphaseTaps& taps, int sample) const {
   Raw acc = 0;  // uQb.(L + T); linear space uQ1.(P + T)
-  for (std::size_t j = 0; j < taps.weight.size(); ++j) acc += taps.weight[j] * rows[j][sample];
+  for (std::size_t j = 0; j < taps.weight.size(); ++j) acc += taps.weight[j] * static_cast<Raw>(rows[j][sample]);
   if (linear_space_) return encode_linear(fx::rounded_shift(acc, config_.linear_gaussian_tap_frac_bits, fx::Quant::Rnd));
   // Q_b: the nearest code, exact half-code ties up, as the encoder's quantise_reduced (which counts a double D within
   // its rounding noise of a half as the half); taps sum to 1, so no clamp is needed.
   return static_cast<std::uint16_t>(fx::rounded_shift(acc, config_.gaussian_tap_frac_bits + config_.gaussian_line_frac_bits, fx::Quant::Rnd));
 }
 
-void FixedKernels::gaussian_horizontal_line(const std::uint16_t* codes_row, const Geometry& g, Raw* out,
+template <typename Line>
+void FixedKernels::gaussian_horizontal_line(const std::uint16_t* codes_row, const Geometry& g, Line* out,
                                             bool grey) const {
   const int columns = g.reduced.width;
   if (linear_space_) {  // through the resample ROM: the per-sample path
     for (int k = 0; k < columns; ++k) {
       const PolyphaseTaps& taps = g.gauss_cols[static_cast<std::size_t>(k)];
-      for (int ch = 0; ch < 3; ++ch) out[3 * k + ch] = grey && ch > 0 ? out[3 * k] : gaussian_horizontal(codes_row, taps, ch);
+      for (int ch = 0; ch < 3; ++ch) {
+        out[3 * k + ch] = grey && ch > 0 ? out[3 * k] : static_cast<Line>(gaussian_horizontal(codes_row, taps, ch));
+      }
     }
     return;
   }
@@ -55,11 +59,11 @@ void FixedKernels::gaussian_horizontal_line(const std::uint16_t* codes_row, cons
     const int* index = taps.index.data();
     const Raw* weight = taps.weight.data();
     const std::size_t count = taps.weight.size();
-    Raw* o = out + 3 * k;
+    Line* o = out + 3 * k;
     if (grey) {
       Raw acc = 0;
       for (std::size_t i = 0; i < count; ++i) acc += weight[i] * codes_row[3 * index[i]];
-      o[0] = o[1] = o[2] = fx::rounded_shift(acc, shift, fx::Quant::RndConv);
+      o[0] = o[1] = o[2] = static_cast<Line>(fx::rounded_shift(acc, shift, fx::Quant::RndConv));
       continue;
     }
     Raw acc0 = 0, acc1 = 0, acc2 = 0;
@@ -69,13 +73,14 @@ void FixedKernels::gaussian_horizontal_line(const std::uint16_t* codes_row, cons
       acc1 += weight[i] * pixel[1];
       acc2 += weight[i] * pixel[2];
     }
-    o[0] = fx::rounded_shift(acc0, shift, fx::Quant::RndConv);
-    o[1] = fx::rounded_shift(acc1, shift, fx::Quant::RndConv);
-    o[2] = fx::rounded_shift(acc2, shift, fx::Quant::RndConv);
+    o[0] = static_cast<Line>(fx::rounded_shift(acc0, shift, fx::Quant::RndConv));
+    o[1] = static_cast<Line>(fx::rounded_shift(acc1, shift, fx::Quant::RndConv));
+    o[2] = static_cast<Line>(fx::rounded_shift(acc2, shift, fx::Quant::RndConv));
   }
 }
 
-void FixedKernels::gaussian_vertical_row(const Raw* const* rows, const PolyphaseTaps& taps, int samples,
+template <typename Line>
+void FixedKernels::gaussian_vertical_row(const Line* const* rows, const PolyphaseTaps& taps, int samples,
                                          std::uint16_t* out, bool grey) const {
   if (linear_space_) {  // re-encoded through the threshold ROM: the per-sample path
     for (int i = 0; i < samples; ++i) out[i] = grey && i % 3 > 0 ? out[i - i % 3] : gaussian_vertical(rows, taps, i);
@@ -95,11 +100,20 @@ void FixedKernels::gaussian_vertical_row(const Raw* const* rows, const Polyphase
   const int step = grey ? 3 : 1;
   for (int i = 0; i < samples; i += step) {
     Raw acc = 0;
-    for (std::size_t j = 0; j < count; ++j) acc += weight[j] * rows[j][i];
+    for (std::size_t j = 0; j < count; ++j) acc += weight[j] * static_cast<Raw>(rows[j][i]);
     out[i] = static_cast<std::uint16_t>(fx::rounded_shift(acc, shift, fx::Quant::Rnd));
     if (grey) out[i + 1] = out[i + 2] = out[i];
   }
 }
+
+template std::uint16_t FixedKernels::gaussian_vertical(const Raw* const*, const PolyphaseTaps&, int) const;
+template std::uint16_t FixedKernels::gaussian_vertical(const std::uint32_t* const*, const PolyphaseTaps&, int) const;
+template void FixedKernels::gaussian_horizontal_line(const std::uint16_t*, const Geometry&, Raw*, bool) const;
+template void FixedKernels::gaussian_horizontal_line(const std::uint16_t*, const Geometry&, std::uint32_t*, bool) const;
+template void FixedKernels::gaussian_vertical_row(const Raw* const*, const PolyphaseTaps&, int, std::uint16_t*,
+                                                  bool) const;
+template void FixedKernels::gaussian_vertical_row(const std::uint32_t* const*, const PolyphaseTaps&, int,
+                                                  std::uint16_t*, bool) const;
 
 std::uint16_t FixedKernels::encode_linear(Raw x) const {
   // Binary search over the threshold ROM: b comparisons per reduced sample.

@@ -302,7 +302,14 @@ class StreamingView {
     const int reduced_samples = 3 * g.reduced.width;
     if (full_) {
       delay_.emplace("E_t delay", plan.delay_lines, full_samples);
-      gauss_.emplace("vertical Gaussian", plan.gauss_lines, reduced_samples);
+      // D's line buffer in 32-bit words where its values fit them: half the bytes the vertical half reads.
+      if (core_.kernels().narrow_gaussian_lines()) {
+        gauss_.reset();
+        gauss32_.emplace("vertical Gaussian", plan.gauss_lines, reduced_samples);
+      } else {
+        gauss32_.reset();
+        gauss_.emplace("vertical Gaussian", plan.gauss_lines, reduced_samples);
+      }
       low_lines_.emplace("U of d_t", plan.low_lines, reduced_samples);
       // DESIGN §7 chroma skip: a grey flag beside each line of the three line buffers.
       delay_grey_.emplace("E_t delay grey flags", plan.delay_lines, 1);
@@ -348,14 +355,16 @@ class StreamingView {
     const bool grey = core_.skipping() && FixedKernels::grey_line(in, g.full.width);
     *delay_grey_->write(y_in) = grey ? 1 : 0;
     *gauss_grey_->write(y_in) = grey ? 1 : 0;
-    core_.kernels().gaussian_horizontal_line(in, g, gauss_->write(y_in), grey);
+    if (gauss32_) {
+      core_.kernels().gaussian_horizontal_line(in, g, gauss32_->write(y_in), grey);
+    } else {
+      core_.kernels().gaussian_horizontal_line(in, g, gauss_->write(y_in), grey);
+    }
   }
 
   void reduced_row(int k) {
     const Geometry& g = *g_;
     const PolyphaseTaps& taps = g.gauss_rows[static_cast<std::size_t>(k)];
-    tap_rows_.clear();
-    for (int index : taps.index) tap_rows_.push_back(gauss_->read(source_line(index)));
     std::uint16_t* d = low_lines_->write(k);
     const FixedKernels& kernels = core_.kernels();
     const int reduced_samples = 3 * g.reduced.width;
@@ -364,7 +373,16 @@ class StreamingView {
       return *gauss_grey_->read(source_line(line)) != 0;
     });
     *low_grey_->write(k) = grey ? 1 : 0;
-    kernels.gaussian_vertical_row(tap_rows_.data(), taps, reduced_samples, d, grey);
+    const auto vertical = [&](const auto& ring, auto& tap_rows) {
+      tap_rows.clear();
+      for (int index : taps.index) tap_rows.push_back(ring.read(source_line(index)));
+      kernels.gaussian_vertical_row(tap_rows.data(), taps, reduced_samples, d, grey);
+    };
+    if (gauss32_) {
+      vertical(*gauss32_, tap_rows32_);
+    } else {
+      vertical(*gauss_, tap_rows_);
+    }
     if (store) std::copy(d, d + reduced_samples, low_store_.ptr<std::uint16_t>(k));
   }
 
@@ -443,10 +461,12 @@ class StreamingView {
   // Full frames: line buffers and the frame stores this frame writes.
   std::optional<LineRing<std::uint16_t>> delay_;
   std::optional<LineRing<Raw>> gauss_;
+  std::optional<LineRing<std::uint32_t>> gauss32_;  // in its place where narrow_gaussian_lines
   std::optional<LineRing<std::uint16_t>> low_lines_;
   cv::Mat residual_store_;
   cv::Mat low_store_;
   std::vector<const Raw*> tap_rows_;
+  std::vector<const std::uint32_t*> tap_rows32_;
   fixed_detail::LineScratch scratch_;
   // Reduced frames.
   bool residual_applies_ = false;

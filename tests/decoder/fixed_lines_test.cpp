@@ -385,6 +385,10 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
   }
   std::vector<const std::int64_t*> row_pointers;
   for (const auto& r : rows) row_pointers.push_back(r.data());
+  std::vector<std::vector<std::uint32_t>> rows32;
+  std::vector<const std::uint32_t*> row_pointers32;
+  for (const auto& r : rows) rows32.emplace_back(r.begin(), r.end());
+  for (const auto& r : rows32) row_pointers32.push_back(r.data());
   // The vertical weights as drawn, and mirrored (w_j = w_{n-1-j}: the folded sum where the caller allows it).
   std::array<std::uint32_t, kTaps> mirrored_weight = row_weight;
   for (std::size_t j = 0; j < kTaps / 2; ++j) mirrored_weight[kTaps - 1 - j] = mirrored_weight[j];
@@ -400,19 +404,28 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
   for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
     const TargetMock mock(target);
     std::vector<std::int64_t> columns(kSamples);
+    std::vector<std::uint32_t> columns32(kSamples);  // the 32-bit line words
     fixed_detail::lines::gaussian_columns(row.data(), kRowSamples, plan, kHorizontalShift, columns.data());
+    fixed_detail::lines::gaussian_columns(row.data(), kRowSamples, plan, kHorizontalShift, columns32.data());
     for (std::size_t s = 0; s < kSamples; ++s) {
       ASSERT_EQ(columns[s], expected_columns[s]) << hwy::TargetName(target) << " horizontal sample " << s;
+      ASSERT_EQ(columns32[s], expected_columns[s]) << hwy::TargetName(target) << " horizontal sample " << s << ", 32-bit";
     }
     for (const bool fold : {false, true}) {
       for (const auto* w : {&row_weight, &mirrored_weight}) {
         const std::vector<std::uint16_t> expected = expected_rows(*w);
         std::vector<std::uint16_t> vertical(kSamples);
+        std::vector<std::uint16_t> vertical32(kSamples);
         fixed_detail::lines::gaussian_rows(row_pointers.data(), w->data(), kTaps, kSamples, kVerticalShift, fold,
                                            vertical.data());
+        fixed_detail::lines::gaussian_rows(row_pointers32.data(), w->data(), kTaps, kSamples, kVerticalShift, fold,
+                                           vertical32.data());
         for (std::size_t s = 0; s < kSamples; ++s) {
           ASSERT_EQ(vertical[s], expected[s]) << hwy::TargetName(target) << " vertical sample " << s
                                               << (fold ? " fold" : "") << (w == &row_weight ? "" : " mirrored");
+          ASSERT_EQ(vertical32[s], expected[s]) << hwy::TargetName(target) << " vertical sample " << s
+                                                << (fold ? " fold" : "") << (w == &row_weight ? "" : " mirrored")
+                                                << ", 32-bit";
         }
       }
     }
@@ -427,11 +440,20 @@ TEST(FixedLines, GaussianKernelsRoundAsTheLineFormatsSay) {
     std::vector<std::uint16_t> wide(kSamples);
     fixed_detail::lines::gaussian_rows(wide_pointers.data(), mirrored_weight.data(), kTaps, kSamples, kVerticalShift,
                                        false, wide.data());
+    std::vector<std::vector<std::uint32_t>> wide_rows32;
+    std::vector<const std::uint32_t*> wide_pointers32;
+    for (const auto& r : wide_rows) wide_rows32.emplace_back(r.begin(), r.end());
+    for (const auto& r : wide_rows32) wide_pointers32.push_back(r.data());
+    std::vector<std::uint16_t> wide32(kSamples);
+    fixed_detail::lines::gaussian_rows(wide_pointers32.data(), mirrored_weight.data(), kTaps, kSamples,
+                                       kVerticalShift, false, wide32.data());
     for (std::size_t i = 0; i < kSamples; ++i) {
       std::int64_t acc = 0;
       for (std::size_t j = 0; j < kTaps; ++j) acc += std::int64_t{mirrored_weight[j]} * wide_rows[j][i];
-      ASSERT_EQ(wide[i], static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd)))
-          << hwy::TargetName(target) << " vertical sample " << i << " near 2^32, no fold";
+      const auto expected = static_cast<std::uint16_t>(fx::rounded_shift(acc, kVerticalShift, fx::Quant::Rnd));
+      ASSERT_EQ(wide[i], expected) << hwy::TargetName(target) << " vertical sample " << i << " near 2^32, no fold";
+      ASSERT_EQ(wide32[i], expected) << hwy::TargetName(target) << " vertical sample " << i
+                                     << " near 2^32, no fold, 32-bit";
     }
   }
 }
@@ -487,11 +509,16 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
       for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
         const TargetMock mock(target);
         std::vector<std::int64_t> columns(plan.samples, -1);
+        std::vector<std::uint32_t> columns32(plan.samples, ~0u);
         fixed_detail::lines::gaussian_columns(row.data(), row_samples, plan, kHorizontalShift, columns.data());
+        fixed_detail::lines::gaussian_columns(row.data(), row_samples, plan, kHorizontalShift, columns32.data());
         for (std::size_t s = 0; s < plan.samples; ++s) {
           ASSERT_EQ(columns[s], expected[s]) << hwy::TargetName(target) << " f=" << f
                                               << (regular ? " polyphase" : " gather") << (mirrored ? " mirrored" : "")
                                               << " sample " << s;
+          ASSERT_EQ(columns32[s], expected[s]) << hwy::TargetName(target) << " f=" << f
+                                                << (regular ? " polyphase" : " gather")
+                                                << (mirrored ? " mirrored" : "") << " sample " << s << ", 32-bit";
         }
       }
      }
