@@ -47,18 +47,22 @@ std::vector<Raw> random_linear(int samples, Raw one, std::uint64_t seed) {
   return values;
 }
 
+// D's halves into and from line buffers of 64-bit or 32-bit words (the streaming decoder's, where the values fit:
+// FixedKernels::narrow_gaussian_lines).
+template <typename Line>
 void BM_GaussianHorizontal(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
   const std::vector<std::uint16_t> line = random_codes(3 * kWidth, kernels.max_code(), 1);
-  std::vector<Raw> out(static_cast<std::size_t>(3 * g.reduced.width));
+  std::vector<Line> out(static_cast<std::size_t>(3 * g.reduced.width));
   for (auto _ : state) {
     kernels.gaussian_horizontal_line(line.data(), g, out.data(), false);
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(state.iterations() * 3 * g.reduced.width);
 }
-BENCHMARK(BM_GaussianHorizontal);
+BENCHMARK_TEMPLATE(BM_GaussianHorizontal, std::uint32_t);
+BENCHMARK_TEMPLATE(BM_GaussianHorizontal, Raw);
 
 // The same line one sample at a time (the per-sample function the line kernel replaced in the schedules).
 void BM_GaussianHorizontalPerSample(benchmark::State& state) {
@@ -79,15 +83,17 @@ void BM_GaussianHorizontalPerSample(benchmark::State& state) {
 }
 BENCHMARK(BM_GaussianHorizontalPerSample);
 
+template <typename Line>
 void BM_GaussianVertical(benchmark::State& state) {
   FixedKernels kernels(config_of("vive"));
   const Geometry& g = kernels.geometry(cv::Size(kWidth, kHeight));
   const int samples = 3 * g.reduced.width;
   const auto& taps = g.gauss_rows[static_cast<std::size_t>(g.reduced.height / 2)];
-  std::vector<std::vector<Raw>> rows;
-  std::vector<const Raw*> pointers;
+  std::vector<std::vector<Line>> rows;
+  std::vector<const Line*> pointers;
   for (std::size_t j = 0; j < taps.weight.size(); ++j) {
-    rows.push_back(random_linear(samples, Raw{255} << 16, 10 + j));
+    const std::vector<Raw> values = random_linear(samples, Raw{255} << 16, 10 + j);
+    rows.emplace_back(values.begin(), values.end());
   }
   for (const auto& r : rows) pointers.push_back(r.data());
   std::vector<std::uint16_t> out(static_cast<std::size_t>(samples));
@@ -97,7 +103,8 @@ void BM_GaussianVertical(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * samples);
 }
-BENCHMARK(BM_GaussianVertical);
+BENCHMARK_TEMPLATE(BM_GaussianVertical, std::uint32_t);
+BENCHMARK_TEMPLATE(BM_GaussianVertical, Raw);
 
 // U of two reduced rows and the EOTF LUT after it: L or alpha of one output line.
 void BM_UpsampleLinear(benchmark::State& state) {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <opencv2/core.hpp>
 #include <span>
+#include <array>
 #include <vector>
 
 namespace trm::fixed_detail {
@@ -46,6 +47,34 @@ struct FrameTally {
   }
 };
 
+// The bands a whole view of an eye ran in on several threads (their first output rows) and the seconds each took: the
+// simulation's schedule, which the next view of the same kind balances its bands by (no modelled store).
+struct BandTimes {
+  int height = 0;
+  std::vector<int> begins;
+  std::vector<double> seconds;
+};
+
+// Output rows [begin, end) of a view decoded in bands, and the rows of d_t [reduced_begin, reduced_end) the band
+// writes to the d_t frame store (the rows its outputs need from the band above are computed again, not stored
+// twice).
+struct RowBand {
+  int begin = 0;
+  int end = 0;
+  int reduced_begin = 0;
+  int reduced_end = 0;
+};
+// A band re-reads the Gaussian's support above it, so short bands waste work.
+constexpr int kMinBandRows = 64;
+// The bands of a view for `threads` threads: equal shares of the output rows, none shorter than kMinBandRows.
+std::vector<RowBand> row_bands(const Geometry& g, int threads);
+// `count` bands (as many as row_bands gives) of about equal cost by the times `last` measured for the eye's last view
+// of the same kind (a cost per row in each of its bands), none shorter than kMinBandRows / 2; row_bands' equal shares
+// where there is no such view or no such split. A reduced view's cost follows its content (the runs and lines that
+// hold a residual, the static lines), which moves little from one view to the next: with equal shares its bands'
+// times differed by up to 2x.
+std::vector<RowBand> balanced_bands(const Geometry& g, int count, const BandTimes& last);
+
 // What persists between frames of one eye (DESIGN §5 frame stores).
 struct EyeState {
   cv::Size full_size;
@@ -70,6 +99,7 @@ struct EyeState {
   // a view in steady state allocates (and faults in) no frame-sized memory.
   std::vector<DecodedFrame> spare_outputs;
   std::vector<cv::Mat> spare_planes;
+  std::array<BandTimes, 2> band_times;  // of the last reduced [0] and full [1] view decoded in bands
 };
 
 // A new frame-sized plane whose whole 2 MiB spans are advised to the kernel for transparent huge pages (Linux

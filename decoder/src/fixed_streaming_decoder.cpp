@@ -16,6 +16,8 @@
 #include "line_ring.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <atomic>
 #include <exception>
 #include <limits>
@@ -134,38 +136,61 @@ void repeat_line(LineRing<T>& ring, int line, int samples) {
 
 namespace fixed_detail {
 
-// Output rows [begin, end) of a view decoded in bands, and the rows of d_t [reduced_begin, reduced_end) the band
-// writes to the d_t frame store (the rows its outputs need from the band above are computed again, not stored
-// twice).
-struct RowBand {
-  int begin = 0;
-  int end = 0;
-  int reduced_begin = 0;
-  int reduced_end = 0;
-};
-
-// The bands of a view: equal shares of the output rows, none shorter than kMinBandRows (a band re-reads the
-// Gaussian's support above it, so short bands waste work).
-constexpr int kMinBandRows = 64;
 // Bands per thread of a whole view (FixedStreamingDecoder::decode_in_bands): more than one, so that a thread held up
 // by other work on its core leaves part of its share to the others, and few, as each band computes D's support above
 // it again (docs/performance_history.md).
 constexpr int kBandsPerThread = 2;
 
-std::vector<RowBand> row_bands(const Geometry& g, int threads) {
-  const int count = std::max(1, std::min(threads, g.full.height / kMinBandRows));
-  std::vector<RowBand> bands(static_cast<std::size_t>(count));
-  for (int b = 0; b < count; ++b) {
-    RowBand& band = bands[static_cast<std::size_t>(b)];
-    band.begin = static_cast<int>(static_cast<std::int64_t>(g.full.height) * b / count);
-    band.end = static_cast<int>(static_cast<std::int64_t>(g.full.height) * (b + 1) / count);
+// The bands that start at the output rows `begins` (increasing from 0; the last ends at the view's end).
+std::vector<RowBand> bands_from(const Geometry& g, const std::vector<int>& begins) {
+  const std::size_t count = begins.size();
+  std::vector<RowBand> bands(count);
+  for (std::size_t b = 0; b < count; ++b) {
+    RowBand& band = bands[b];
+    band.begin = begins[b];
+    band.end = b + 1 < count ? begins[b + 1] : g.full.height;
     band.reduced_begin = b == 0 ? 0 : g.bilinear_rows[static_cast<std::size_t>(band.begin)].i0;
   }
-  for (int b = 0; b < count; ++b) {
-    bands[static_cast<std::size_t>(b)].reduced_end =
-        b + 1 < count ? bands[static_cast<std::size_t>(b) + 1].reduced_begin : g.reduced.height;
+  for (std::size_t b = 0; b < count; ++b) {
+    bands[b].reduced_end = b + 1 < count ? bands[b + 1].reduced_begin : g.reduced.height;
   }
   return bands;
+}
+
+std::vector<RowBand> row_bands(const Geometry& g, int threads) {
+  const int count = std::max(1, std::min(threads, g.full.height / kMinBandRows));
+  std::vector<int> begins(static_cast<std::size_t>(count));
+  for (int b = 0; b < count; ++b) {
+    begins[static_cast<std::size_t>(b)] = static_cast<int>(static_cast<std::int64_t>(g.full.height) * b / count);
+  }
+  return bands_from(g, begins);
+}
+
+std::vector<RowBand> balanced_bands(const Geometry& g, int count, const BandTimes& last) {
+  const int height = g.full.height;
+  count = std::max(1, std::min(count, height / kMinBandRows));
+  const std::size_t n = last.begins.size();
+  bool usable = count > 1 && last.height == height && n >= 1 && last.seconds.size() == n && last.begins[0] == 0;
+  double total = 0.0;
+  for (std::size_t b = 0; usable && b < n; ++b) {
+    const int end = b + 1 < n ? last.begins[b + 1] : height;
+    usable = end > last.begins[b] && std::isfinite(last.seconds[b]) && last.seconds[b] > 0.0;
+    total += usable ? last.seconds[b] : 0.0;
+  }
+  if (!usable) return row_bands(g, count);
+  std::vector<int> begins{0};
+  std::size_t b = 0;       // the last view's band holding the row reached
+  double before_b = 0.0;   // the cost of the last view's bands before b
+  for (int k = 1; k < count; ++k) {
+    const double wanted = total * k / count;
+    while (b + 1 < n && before_b + last.seconds[b] <= wanted) before_b += last.seconds[b++];
+    const int first = last.begins[b];
+    const int end = b + 1 < n ? last.begins[b + 1] : height;
+    const int row = first + static_cast<int>((wanted - before_b) / last.seconds[b] * (end - first));
+    if (row - begins.back() < kMinBandRows / 2 || height - row < kMinBandRows / 2) return row_bands(g, count);
+    begins.push_back(row);
+  }
+  return bands_from(g, begins);
 }
 
 // One view in flight through the streaming schedule, line by line.
@@ -257,6 +282,8 @@ class StreamingView {
   // the first line (FixedDecoderCore::start_output may then take the held output's plane), and its rows outlive the
   // view (the input rings hold them where they are).
   void mark_whole_frame() { whole_frame_ = true; }
+  // The eye's record of its last view of this kind decoded in bands.
+  BandTimes& band_times() { return eye_->band_times[full_ ? 1 : 0]; }
 
   DecodedFrame finish() {
     if (!started_) return core_.decode_lost(meta_, kWho);
@@ -629,8 +656,10 @@ DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
     const std::size_t threads = fixed_detail::row_bands(g, core_->config().threads).size();
     // More bands than threads, each taken by the next thread free: a thread held up by other work on its core (a
     // feed's reading and sending) leaves the rest of the view to the others instead of keeping them waiting.
+    fixed_detail::BandTimes& times = view_->band_times();
     const std::vector<fixed_detail::RowBand> bands =
-        fixed_detail::row_bands(g, core_->config().threads * fixed_detail::kBandsPerThread);
+        fixed_detail::balanced_bands(g, core_->config().threads * fixed_detail::kBandsPerThread, times);
+    std::vector<double> band_seconds(bands.size(), 0.0);
     // Each band's view is built when a thread takes the band, as a copy of this view, which runs none and so keeps
     // the state every band starts from, and let go when its tally is in: as many band views at a time as threads.
     std::vector<std::exception_ptr> failed(bands.size());
@@ -640,8 +669,10 @@ DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
     const auto run_bands = [&] {
       for (std::size_t b; (b = next_band.fetch_add(1, std::memory_order_relaxed)) < bands.size();) {
         try {
+          const auto start = std::chrono::steady_clock::now();
           const std::unique_ptr<fixed_detail::StreamingView> band = view_->band_view(bands[b]);
           band->run_band(frame.codes);
+          band_seconds[b] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
           const std::lock_guard lock(tally_mutex);
           band->add_tally_to(bands_tally);
         } catch (...) {
@@ -657,6 +688,10 @@ DecodedFrame FixedStreamingDecoder::decode_in_bands(const LinkFrame& frame) {
     for (const std::exception_ptr& e : failed) {
       if (e) std::rethrow_exception(e);
     }
+    times.height = g.full.height;
+    times.begins.clear();
+    for (const fixed_detail::RowBand& band : bands) times.begins.push_back(band.begin);
+    times.seconds = std::move(band_seconds);
     view_->absorb(bands_tally);
     view_->mark_all_pushed();
   } catch (...) {

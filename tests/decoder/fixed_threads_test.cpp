@@ -1,10 +1,12 @@
 // Execution settings of the fixed-point decoder that must not change a bit: the streaming decoder's bands of output
 // lines on several threads (FixedDecoderConfig::threads) and the drive codes without the report planes
 // (FixedDecoderConfig::report_planes).
+#include "fixed_core.hpp"
 #include "fixed_decoder_test_support.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -120,6 +122,45 @@ TEST(FixedThreads, MoreBandsThanThreadsGiveTheOnePipelineBits) {
                            "tall discs " + panel);
     if (HasFatalFailure()) return;
   }
+}
+
+// The bands of a whole view balanced by the times of the eye's last view of the same kind: cut where the cost
+// measured per row reaches each quarter of the total, and row_bands' equal shares where there is no usable record.
+TEST(FixedThreads, BandsAreCutAtEqualCostsOfTheLastView) {
+  fixed_detail::FixedKernels kernels(fixed_config(link_config(0.5), "vive"));  // (geometry() builds and keeps one)
+  const fixed_detail::Geometry& g = kernels.geometry(cv::Size(kWidth, 1200));
+  const auto begins = [](const std::vector<fixed_detail::RowBand>& bands) {
+    std::vector<int> out;
+    for (const fixed_detail::RowBand& band : bands) out.push_back(band.begin);
+    return out;
+  };
+  const std::vector<int> even = {0, 300, 600, 900};
+  EXPECT_EQ(begins(fixed_detail::row_bands(g, 4)), even);
+  // The last view: rows 0-599 took 1 s, rows 600-1199 3 s; a quarter of the 4 s is all of the first band.
+  fixed_detail::BandTimes last{1200, {0, 600}, {1.0, 3.0}};
+  const std::vector<fixed_detail::RowBand> balanced = fixed_detail::balanced_bands(g, 4, last);
+  EXPECT_EQ(begins(balanced), (std::vector<int>{0, 600, 800, 1000}));
+  // Every band's d_t rows follow the next band's first output row, as row_bands gives them, and cover d_t once.
+  ASSERT_EQ(balanced.size(), 4u);
+  EXPECT_EQ(balanced.back().end, 1200);
+  EXPECT_EQ(balanced.front().reduced_begin, 0);
+  EXPECT_EQ(balanced.back().reduced_end, g.reduced.height);
+  for (std::size_t b = 0; b + 1 < balanced.size(); ++b) {
+    EXPECT_EQ(balanced[b].end, balanced[b + 1].begin);
+    EXPECT_EQ(balanced[b + 1].reduced_begin, g.bilinear_rows[static_cast<std::size_t>(balanced[b + 1].begin)].i0);
+    EXPECT_EQ(balanced[b].reduced_end, balanced[b + 1].reduced_begin);
+  }
+  // No usable record: another view size, a time that is not positive or not finite, cuts that would leave bands
+  // shorter than kMinBandRows / 2 (all the cost in rows 1000-1059: cuts at 1015, 1030 and 1045).
+  for (const fixed_detail::BandTimes& unusable :
+       {fixed_detail::BandTimes{}, fixed_detail::BandTimes{1100, {0, 600}, {1.0, 3.0}},
+        fixed_detail::BandTimes{1200, {0, 600}, {0.0, 3.0}}, fixed_detail::BandTimes{1200, {0, 600}, {NAN, 3.0}},
+        fixed_detail::BandTimes{1200, {0, 1000, 1060}, {1e-9, 1.0, 1e-9}}}) {
+    EXPECT_EQ(begins(fixed_detail::balanced_bands(g, 4, unusable)), even);
+  }
+  // As many bands as row_bands gives: a 100-row view has one.
+  const fixed_detail::Geometry& short_view = kernels.geometry(cv::Size(kWidth, 100));
+  EXPECT_EQ(fixed_detail::balanced_bands(short_view, 4, fixed_detail::BandTimes{100, {0, 50}, {1.0, 3.0}}).size(), 1u);
 }
 
 TEST(FixedThreads, ShortViewsRunOnFewerThreadsAndCountsOutOfRangeAreRejected) {
