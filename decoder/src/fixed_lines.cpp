@@ -198,6 +198,49 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
   const hn::Rebind<std::uint16_t, decltype(du)> d16;
   const std::size_t lanes = hn::Lanes(du);
   const auto unit = hn::Set(du, plan.unit);
+  const auto by_formula = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::uint32_t w = plan.upper[s];
+      out[s] = (plan.unit - w) * row[static_cast<std::size_t>(plan.left[s])] +
+               w * row[static_cast<std::size_t>(plan.right[s])];
+    }
+  };
+  if (plan.half && lanes >= 8 && n == 2 * row_samples) {
+    // Output vector at sample s: pixel pair P = s / 6 (its even column's first sample), the row windows at 3P (a_j)
+    // and 3P -+ 3 (the neighbours); lane l reads window lane 3 ((s + l) / 6 - P) + (s + l) mod 3, from the window
+    // after where (s + l) mod 6 >= 3 (an odd column). s mod 6 is 0, then lanes mod 6 and twice it: three patterns.
+    HWY_ALIGN std::int32_t lane_of[3][hn::MaxLanes(di)];
+    HWY_ALIGN std::int32_t odd_of[3][hn::MaxLanes(di)];
+    for (std::size_t pattern = 0; pattern < 3; ++pattern) {
+      const std::size_t s = pattern * lanes;
+      for (std::size_t l = 0; l < lanes; ++l) {
+        const std::size_t o = s + l;
+        lane_of[pattern][l] = static_cast<std::int32_t>(3 * (o / 6 - s / 6) + o % 3);
+        odd_of[pattern][l] = o % 6 >= 3 ? -1 : 0;
+      }
+    }
+    const hn::Vec<decltype(di)> lane_vectors[3] = {hn::Load(di, lane_of[0]), hn::Load(di, lane_of[1]),
+                                                   hn::Load(di, lane_of[2])};
+    const hn::Vec<decltype(di)> odd_vectors[3] = {hn::Load(di, odd_of[0]), hn::Load(di, odd_of[1]),
+                                                  hn::Load(di, odd_of[2])};
+    const int quarter_shift = std::countr_zero(plan.unit) - 2;
+    const auto load = [&](std::size_t at) { return hn::PromoteTo(du, hn::LoadU(d16, row + at)); };
+    // From pixel pair 1 (a pixel before it; s = 6 is 0 mod 6, pattern 0) while the windows stay in the row.
+    std::size_t s = 6;
+    by_formula(0, s);
+    for (std::size_t pattern = 0; s + lanes <= n && 3 * (s / 6) + 3 + lanes <= row_samples;
+         s += lanes, pattern = pattern == 2 ? 0 : pattern + 1) {
+      const std::size_t at = 3 * (s / 6);
+      const auto index = hn::IndicesFromVec(du, lane_vectors[pattern]);
+      const auto a = hn::TableLookupLanes(load(at), index);
+      const auto before = hn::TableLookupLanes(load(at - 3), index);
+      const auto after = hn::TableLookupLanes(load(at + 3), index);
+      const auto other = hn::IfThenElse(hn::RebindMask(du, hn::MaskFromVec(odd_vectors[pattern])), after, before);
+      hn::StoreU(hn::ShiftLeftSame(hn::Add(other, hn::Add(a, hn::ShiftLeft<1>(a))), quarter_shift), du, out + s);
+    }
+    by_formula(s, n);
+    return;
+  }
   // The reduced row's samples widened once, so the taps are 32-bit gathers.
   thread_local std::vector<std::uint32_t> wide;
   wide.resize(row_samples + 2 * lanes);  // a window's second vector may reach past the row
@@ -2199,6 +2242,27 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
     const std::size_t lanes = std::size_t{4} << i;
     plan.windows[i] = build(lanes, lanes);
     plan.double_windows[i] = build(lanes, 2 * lanes);  // also where the single fit, for the tests to take them
+  }
+  // r = 1/2: each sample's coefficients per row sample against the quarters (ColumnBlendPlan::half).
+  const int pixels = g.reduced.width;
+  plan.half = W >= 2 && pixels >= 2 && g.full.width == 2 * pixels;
+  for (std::size_t s = 0; s < samples && plan.half; ++s) {
+    const int x = static_cast<int>(s / 3);
+    const int ch = static_cast<int>(s % 3);
+    const int m = x / 2;
+    const int outer = x % 2 == 0 ? std::max(m - 1, 0) : std::min(m + 1, pixels - 1);
+    // The row samples a sample reads with a coefficient other than 0, and the coefficients, in order.
+    const auto coefficients = [](std::int32_t a, std::uint64_t wa, std::int32_t b, std::uint64_t wb) {
+      std::array<std::pair<std::int32_t, std::uint64_t>, 2> c{std::pair{a, wa}, std::pair{b, wb}};
+      if (c[0].first == c[1].first) c = {std::pair{a, wa + wb}, std::pair{-1, std::uint64_t{0}}};
+      for (auto& [index, weight] : c) {
+        if (weight == 0) index = -1;
+      }
+      if (c[0].first > c[1].first) std::swap(c[0], c[1]);
+      return c;
+    };
+    plan.half = coefficients(plan.left[s], unit - plan.upper[s], plan.right[s], plan.upper[s]) ==
+                coefficients(3 * outer + ch, unit / 4, 3 * m + ch, 3 * (unit / 4));
   }
   return plan;
 }

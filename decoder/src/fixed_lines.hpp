@@ -55,6 +55,13 @@ struct ColumnBlendPlan {
   }
   const Windows* windows_for(std::size_t lanes) const { return of_width(windows, lanes); }
   const Windows* double_windows_for(std::size_t lanes) const { return of_width(double_windows, lanes); }
+  // r = 1/2: every full column 2m blends reduced columns m - 1 and m by 1/4 and 3/4, and 2m + 1 columns m and m + 1 by
+  // 3/4 and 1/4 (clamped at the row's ends; column_blend_plan checks each sample's coefficients). An output sample is
+  // then (a_{j +- 3} + 3 a_j) 2^(W - 2) of its own channel's row samples j and j -+ 3 (the neighbour pixel before for
+  // an even column, after for an odd one): a vector of L >= 8 output samples from one lane permutation of each of
+  // three windows of L row samples, one pixel apart (no weights, no gathers). The permutation repeats every third
+  // vector.
+  bool half = false;
 };
 
 // U's row blend, its rounding to uQb.U and the EOTF ROM interpolation (FixedKernels::linear_of_upsampled): node y_i

@@ -668,17 +668,22 @@ TEST(FixedLines, OledDriveKernelAtOctaveAndBucketEnds) {
   }
 }
 
-// U's column blend through its windows (a vector's taps within one vector of row samples, permuted), through its
-// double windows (two vectors) and through the gather, against the blend's formula, at a headset width and a narrow
-// one with tails, on every instruction set.
+// U's column blend at r = 1/2 by the quarters' sums (ColumnBlendPlan::half), through its windows (a vector's taps
+// within one vector of row samples, permuted), through its double windows (two vectors) and through the gather,
+// against the blend's formula, at a headset width and narrow ones with tails, on every instruction set.
 TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
   std::mt19937_64 random(31);
-  for (const auto& [width, r] : {std::pair{2160, 0.5}, std::pair{67, 0.25}, std::pair{67, 0.75}}) {
+  for (const auto& [width, r] :
+       {std::pair{2160, 0.5}, std::pair{68, 0.5}, std::pair{46, 0.5}, std::pair{67, 0.25}, std::pair{67, 0.75}}) {
     fixed_detail::FixedKernels kernels(fixed_config(link_config(r), "vive"));
     const fixed_detail::Geometry& g = kernels.geometry(cv::Size(width, 24));
     const fixed_detail::ColumnBlendPlan& plan = g.column_blend;
     ASSERT_FALSE(plan.left.empty());
-    fixed_detail::ColumnBlendPlan double_copy = plan;
+    EXPECT_EQ(plan.half, r == 0.5) << "width " << width << " r " << r;
+    fixed_detail::ColumnBlendPlan windows_copy = plan;
+    windows_copy.half = false;
+    const fixed_detail::ColumnBlendPlan& windows_only = windows_copy;
+    fixed_detail::ColumnBlendPlan double_copy = windows_copy;
     double_copy.windows = {};
     const fixed_detail::ColumnBlendPlan& double_only = double_copy;
     fixed_detail::ColumnBlendPlan gather_copy = double_copy;
@@ -701,12 +706,15 @@ TEST(FixedLines, ColumnBlendWindowsGiveTheBlendsBits) {
     }
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
       const TargetMock mock(target);
-      for (const fixed_detail::ColumnBlendPlan* p : {&plan, &double_only, &gather_only}) {
+      for (const fixed_detail::ColumnBlendPlan* p : {&plan, &windows_only, &double_only, &gather_only}) {
         std::vector<std::uint32_t> out(n);
         fixed_detail::lines::blend_columns(row.data(), *p, n, out.data());
         for (std::size_t s = 0; s < n; ++s) {
           ASSERT_EQ(out[s], expected[s]) << hwy::TargetName(target) << " width " << width << " r " << r
-                                         << (p == &plan ? " windows" : p == &double_only ? " double windows" : " gather")
+                                         << (p == &plan            ? " as planned"
+                                             : p == &windows_only  ? " windows"
+                                             : p == &double_only   ? " double windows"
+                                                                   : " gather")
                                          << " sample " << s;
         }
       }
