@@ -48,7 +48,7 @@ struct FrameTally {
 };
 
 // The bands a whole view of an eye ran in on several threads (their first output rows) and the seconds each took: the
-// simulation's schedule, which the next view of the same kind balances its bands by (no modelled store).
+// simulation's schedule, which the next view of the same kind and height balances its bands by (no modelled store).
 struct BandTimes {
   int height = 0;
   std::vector<int> begins;

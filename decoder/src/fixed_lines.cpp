@@ -843,18 +843,6 @@ void GaussianColumnsOf(const std::uint16_t* row, [[maybe_unused]] std::size_t ro
   for (; s < n; ++s) out[s] = scalar(s);
 }
 
-#if HWY_TARGET != HWY_SCALAR
-// A 64-bit line's words (the 32-bit instantiation's body never reaches this: its vectors are whole 32-bit words).
-template <class D, typename Line>
-HWY_INLINE hn::Vec<D> LoadLine(D d, const Line* p) {
-  if constexpr (sizeof(Line) == 8) {
-    return hn::LoadU(d, p);
-  } else {
-    return hn::PromoteTo(d, hn::LoadU(hn::Rebind<std::int32_t, D>(), reinterpret_cast<const std::int32_t*>(p)));
-  }
-}
-#endif
-
 // From 64-bit or 32-bit line words. On 32-bit words a vector holds twice the samples: the products of its even and
 // odd lanes are summed apart in 64-bit lanes and the two results' 16 bits put back in order.
 template <typename Line>
@@ -900,18 +888,20 @@ void GaussianRowsOf(const Line* const* rows, const std::uint32_t* weight, std::s
       hn::StoreU(hn::BitCast(d16_pairs, pairs), d16_pairs, out + i);
     }
   }
-  for (; sizeof(Line) == 8 && i + lanes <= n; i += lanes) {
-    auto acc = hn::Zero(du);
-    for (std::size_t j = 0; j < folded; ++j) {
-      const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
-      const auto pair = hn::Add(LoadLine(d, rows[j] + i), LoadLine(d, rows[count - 1 - j] + i));
-      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, pair)));
+  if constexpr (sizeof(Line) == 8) {
+    for (; i + lanes <= n; i += lanes) {
+      auto acc = hn::Zero(du);
+      for (std::size_t j = 0; j < folded; ++j) {
+        const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
+        const auto pair = hn::Add(hn::LoadU(d, rows[j] + i), hn::LoadU(d, rows[count - 1 - j] + i));
+        acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, pair)));
+      }
+      for (std::size_t j = folded; j < count - folded; ++j) {
+        const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
+        acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, hn::LoadU(d, rows[j] + i))));
+      }
+      hn::StoreU(hn::TruncateTo(d16, hn::ShiftRightSame(hn::Add(acc, half), shift)), d16, out + i);
     }
-    for (std::size_t j = folded; j < count - folded; ++j) {
-      const auto w = hn::BitCast(du32, hn::Set(du, std::uint64_t{weight[j]}));
-      acc = hn::Add(acc, hn::MulEven(w, hn::BitCast(du32, LoadLine(d, rows[j] + i))));
-    }
-    hn::StoreU(hn::TruncateTo(d16, hn::ShiftRightSame(hn::Add(acc, half), shift)), d16, out + i);
   }
 #endif
   for (; i < n; ++i) {
@@ -1043,8 +1033,9 @@ inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const Fix
 #if HWY_TARGET != HWY_SCALAR
 // The LCD drive of a 32-bit line through LcdPlan::composed, in 32-bit lanes: per sample the composed word and the
 // row's ends (a second word lookup on the eye's first frame, for v_{t-1} from the held row). Vectors with a value
-// outside [-2^30, 2^30] (where the sum or 2 M^gamma - x_{t-1} could leave 32 bits) take lcd_scalar. Returns the
-// samples done (whole vectors); adds the unreachable ones to `unreachable`.
+// outside (-2^29, 2^29) take lcd_scalar: within it the sum, 2 M^gamma - x_{t-1} and the shortfall stay within 32 bits
+// (ends32 holds 2 M^gamma <= 2^30). Returns the samples done (whole vectors); adds the unreachable ones to
+// `unreachable`.
 std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
                              std::uint8_t* previous_code, std::int32_t* previous_linear, bool held,
                              std::uint16_t* codes, std::int64_t* shortfall, std::uint64_t& unreachable) {
@@ -1073,7 +1064,7 @@ std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const Lc
   const auto row_words = hn::Set(d, buckets);
   const auto held_row = hn::Set(d, static_cast<std::int32_t>(p.width * buckets));
   const auto top = hn::Set(d, p.top);
-  const auto bound = hn::Set(d, std::int32_t{1} << 30);
+  const auto bound = hn::Set(d, (std::int32_t{1} << 29) - 1);
   auto unreachable_lanes = zero;
   const auto load_previous = [&](std::size_t i, const auto x) {
     return held ? x : hn::LoadU(d, previous_linear + i);
@@ -2120,7 +2111,7 @@ void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target) {
   for (std::size_t v = 0; v < ends.size(); ++v) {
     const std::int64_t dark = 2 * plan.ends[2 * v];
     const std::int64_t bright = 2 * plan.ends[2 * v + 1];
-    if (dark < 0 || bright < 0 || dark > INT32_MAX || bright > INT32_MAX) return;
+    if (dark < 0 || bright < 0 || dark > (std::int64_t{1} << 30) || bright > (std::int64_t{1} << 30)) return;
     ends[v] = static_cast<std::uint64_t>(dark) | (static_cast<std::uint64_t>(bright) << 32);
   }
   const int code_bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(plan.top)));
@@ -2245,7 +2236,7 @@ ColumnBlendPlan column_blend_plan(const Geometry& g, std::uint32_t unit) {
   }
   // r = 1/2: each sample's coefficients per row sample against the quarters (ColumnBlendPlan::half).
   const int pixels = g.reduced.width;
-  plan.half = W >= 2 && pixels >= 2 && g.full.width == 2 * pixels;
+  plan.half = std::has_single_bit(unit) && W >= 2 && pixels >= 2 && g.full.width == 2 * pixels;
   for (std::size_t s = 0; s < samples && plan.half; ++s) {
     const int x = static_cast<int>(s / 3);
     const int ch = static_cast<int>(s % 3);

@@ -235,7 +235,7 @@ struct LcdPlan {
   // The target ROM and the search in one lookup (lcd_composed_index; a simulation table, as FixedLinePlans::
   // drive_of_node: the modelled hardware runs both). The code depends on the sum x_t + x_{t-1} only through the ROM's
   // input c = min(max(sum, 0) >> target_shift, 2^target_input_bits), c = 2^target_input_bits standing for the target
-  // one: per row r, C_k = the least c whose target reaches U_k is increasing in k, and the code is the number of
+  // one: per row r, C_k = the least c whose target reaches U_k does not fall as k rises, and the code is the number of
   // C_k at or below c. Word [r composed_buckets + b] holds, for bucket b of c addressed by c's float with
   // composed_mantissa_bits (as DrivePlan::packed32), the code at the bucket's lower end shifted left by
   // composed_offset_bits, above the offset of the row's next C_k from it (the bucket's width where that lies past
@@ -247,7 +247,7 @@ struct LcdPlan {
   int composed_offset_bits = 0;
   std::int32_t composed_buckets = 0;
   // Per v_{t-1}: 2 M(0, v_{t-1})^gamma in the low 32 bits, 2 M(1, v_{t-1})^gamma in the high, the
-  // sums' unreachable ends for the composed kernel's 32-bit lanes (both below 2^31 wherever composed is built).
+  // sums' unreachable ends for the composed kernel's 32-bit lanes (both at most 2^30 wherever composed is built).
   std::vector<std::uint64_t> ends32;
 };
 

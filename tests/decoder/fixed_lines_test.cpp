@@ -832,9 +832,20 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
       previous_linear[s] = static_cast<std::int32_t>(s % 5 == 0 ? -(linear(random) / 8) : linear(random));
       if (s % 11 == 0) wanted[s] = previous_linear[s] = 0;
       if (s % 13 == 0) wanted[s] = one, previous_linear[s] = static_cast<std::int32_t>(one);
-      // Now and then a stored x_{t-1} past 2^30 either way (a long run of contributed shortfalls): there the sum and
-      // 2 M^gamma - x_{t-1} leave the composed kernel's 32-bit lanes.
-      if (s % 997 == 0) previous_linear[s] = s % 2 == 0 ? INT32_MIN + 1 : (std::int32_t{1} << 30) + 1;
+      // Now and then a stored x_{t-1} at and past the composed kernel's bound (+-2^29: within it the sum, 2 M^gamma -
+      // x_{t-1} and the shortfall stay within 32 bits), as a long run of contributed shortfalls could leave, and
+      // far past it either way; and an x_t at the bound (the kernels take any 32-bit line).
+      constexpr std::int32_t kBound = std::int32_t{1} << 29;
+      const std::array<std::int32_t, 8> edges = {kBound - 1, kBound, -(kBound - 1), -kBound, std::int32_t{1} << 30,
+                                                 -(std::int32_t{1} << 30), INT32_MIN + 1, INT32_MAX};
+      if (s % 997 == 0) previous_linear[s] = edges[(s / 997) % edges.size()];
+      if (s % 991 == 0) {  // both at once: the sum of two 2^30 wraps in 32 bits, and so does a shortfall at -2^30
+        const std::array<std::pair<std::int32_t, std::int32_t>, 4> both = {
+            std::pair{kBound - 1, kBound - 1}, std::pair{kBound, kBound - 1}, std::pair{std::int32_t{1} << 30, std::int32_t{1} << 30},
+            std::pair{-(std::int32_t{1} << 30), -(std::int32_t{1} << 30)}};
+        wanted[s] = both[(s / 991) % both.size()].first;
+        previous_linear[s] = both[(s / 991) % both.size()].second;
+      }
       previous_code[s] = static_cast<std::uint8_t>(random() % 256);
     }
     std::vector<std::uint16_t> expected_codes(kSamples);
