@@ -797,6 +797,14 @@ TEST(FixedLines, RowBlendGivesThePerSampleUpsampleOnEveryRow) {
   }
 }
 
+// An LCD configuration at linear format F (the residual's fraction no finer than F).
+FixedDecoderConfig lcd_config_at(int linear_frac_bits) {
+  FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
+  config.linear_frac_bits = linear_frac_bits;
+  config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
+  return config;
+}
+
 // The LCD drive kernel against FixedKernels::lcd_drive and emit's frame-store update, sample by sample: random wanted
 // and previous values (sums from 0 to past 2, so the target ROM's every octave, its bottom region and the clamp to
 // 1 are read), random v_{t-1}, both history modes (Contributed stores negative values after a dark shortfall), the
@@ -811,10 +819,8 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
   for (const auto& [history, linear_frac_bits, held] :
        {Case{LcdHistory::Wanted, 28, false}, Case{LcdHistory::Contributed, 28, false}, Case{LcdHistory::Wanted, 20, false},
         Case{LcdHistory::Wanted, 28, true}, Case{LcdHistory::Contributed, 20, true}}) {
-    FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
+    FixedDecoderConfig config = lcd_config_at(linear_frac_bits);
     config.decoder.lcd_history = history;
-    config.linear_frac_bits = linear_frac_bits;
-    config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
     const fixed_detail::FixedKernels kernels(config);
     const auto& plan = kernels.line_plans().lcd;
     ASSERT_TRUE(plan.has_value());
@@ -907,10 +913,7 @@ TEST(FixedLines, LcdDriveKernelGivesTheStageFunctionsBitsSampleBySample) {
 // itself, and the sums one below and one above it, on every instruction set; at the default F and at F = 20.
 TEST(FixedLines, LcdComposedTableGivesTheStageCodesAtEveryStep) {
   for (const int linear_frac_bits : {28, 20}) {
-    FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
-    config.linear_frac_bits = linear_frac_bits;
-    config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
-    const fixed_detail::FixedKernels kernels(config);
+    const fixed_detail::FixedKernels kernels(lcd_config_at(linear_frac_bits));
     ASSERT_TRUE(kernels.line_plans().lcd.has_value());
     const fixed_detail::LcdPlan& plan = *kernels.line_plans().lcd;
     ASSERT_FALSE(plan.composed.empty()) << "F = " << linear_frac_bits;
@@ -970,10 +973,7 @@ TEST(FixedLines, LcdComposedTableGivesTheStageCodesAtEveryStep) {
 // at the default F and at F = 20.
 TEST(FixedLines, LcdIndexGivesTheBinarySearchCodesAtEveryThreshold) {
   for (const int linear_frac_bits : {28, 20}) {
-    FixedDecoderConfig config = fixed_config(link_config(0.5), "lcd");
-    config.linear_frac_bits = linear_frac_bits;
-    config.residual.frac_bits = std::min(config.residual.frac_bits, linear_frac_bits);
-    const fixed_detail::FixedKernels kernels(config);
+    const fixed_detail::FixedKernels kernels(lcd_config_at(linear_frac_bits));
     ASSERT_TRUE(kernels.line_plans().lcd.has_value());
     const fixed_detail::LcdPlan& indexed = *kernels.line_plans().lcd;
     ASSERT_FALSE(indexed.index.empty()) << "F = " << linear_frac_bits;
