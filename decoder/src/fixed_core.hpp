@@ -7,12 +7,12 @@
 #include "view_arrival.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <opencv2/core.hpp>
 #include <span>
-#include <array>
 #include <vector>
 
 namespace trm::fixed_detail {

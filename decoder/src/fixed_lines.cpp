@@ -186,18 +186,7 @@ inline std::uint16_t drive_scalar(std::int64_t x, std::size_t s, const DrivePlan
 // The scalar target (x86-64 CPUs without SSSE3) has one lane, where the vector bodies' lane pairing does not apply:
 // there the tails' loops do the whole line.
 void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::size_t n, std::uint32_t* out) {
-#if HWY_TARGET == HWY_SCALAR
-  for (std::size_t s = 0; s < n; ++s) {
-    const std::uint32_t w = plan.upper[s];
-    out[s] = (plan.unit - w) * row[static_cast<std::size_t>(plan.left[s])] + w * row[static_cast<std::size_t>(plan.right[s])];
-  }
-#else
-  const std::size_t row_samples = static_cast<std::size_t>(std::max(plan.left.back(), plan.right.back())) + 1;
-  const hn::ScalableTag<std::uint32_t> du;
-  const hn::RebindToSigned<decltype(du)> di;
-  const hn::Rebind<std::uint16_t, decltype(du)> d16;
-  const std::size_t lanes = hn::Lanes(du);
-  const auto unit = hn::Set(du, plan.unit);
+  // The blend's formula, sample by sample: the scalar target, the tails, the quarter path's edges.
   const auto by_formula = [&](std::size_t begin, std::size_t end) {
     for (std::size_t s = begin; s < end; ++s) {
       const std::uint32_t w = plan.upper[s];
@@ -205,6 +194,15 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
                w * row[static_cast<std::size_t>(plan.right[s])];
     }
   };
+#if HWY_TARGET == HWY_SCALAR
+  by_formula(0, n);
+#else
+  const std::size_t row_samples = static_cast<std::size_t>(std::max(plan.left.back(), plan.right.back())) + 1;
+  const hn::ScalableTag<std::uint32_t> du;
+  const hn::RebindToSigned<decltype(du)> di;
+  const hn::Rebind<std::uint16_t, decltype(du)> d16;
+  const std::size_t lanes = hn::Lanes(du);
+  const auto unit = hn::Set(du, plan.unit);
   if (plan.half && lanes >= 8 && n == 2 * row_samples) {
     // Output vector at sample s: pixel pair P = s / 6 (its even column's first sample), the row windows at 3P (a_j)
     // and 3P -+ 3 (the neighbours); lane l reads window lane 3 ((s + l) / 6 - P) + (s + l) mod 3, from the window
@@ -281,10 +279,7 @@ void BlendColumns(const std::uint16_t* row, const ColumnBlendPlan& plan, std::si
     const auto w = hn::LoadU(du, plan.upper.data() + s);
     hn::StoreU(hn::Add(hn::Mul(hn::Sub(unit, w), a), hn::Mul(w, b)), du, out + s);
   }
-  for (; s < n; ++s) {
-    const std::uint32_t w = plan.upper[s];
-    out[s] = (plan.unit - w) * wide[static_cast<std::size_t>(plan.left[s])] + w * wide[static_cast<std::size_t>(plan.right[s])];
-  }
+  by_formula(s, n);
 #endif
 }
 
@@ -470,6 +465,41 @@ HWY_INLINE hn::Vec<D> IndexSearch(D d, hn::Vec<D> x, hn::Vec<D> octave, hn::Vec<
 // DriveCodes in 32-bit lanes (DrivePlan::base32 ..): the bucket from a float's exponent and fraction, exact because
 // a value of 2^24 or more (below 2^30) is converted shifted right by 6, below 2^24 and so without rounding, which keeps
 // its top m + 1 bits (m <= 17), and a smaller value is converted as it is.
+#if HWY_TARGET != HWY_SCALAR
+// A table laid out by a value's float with m fraction bits (float_bucket; DrivePlan::packed32, LcdPlan::composed), in
+// 32-bit lanes: a value's bucket (its float's bits shifted right by 23 - m, less 126 << m; 0 for 0) and the value less
+// the bucket's lower end (that float with its fraction bits below the top m cleared, converted back), for a value whose
+// float is exact; and the code from the bucket's word, the code at the lower end shifted left by offset_bits above
+// the offset of the next threshold, which the value reaches or not.
+template <class D>
+struct FloatBuckets {
+  FloatBuckets(D d, int m, int offset_bits)
+      : fraction_shift(23 - m),
+        offset_bits(offset_bits),
+        first_bucket(hn::Set(d, std::int32_t{126} << m)),
+        below_fraction(hn::Set(hn::RebindToUnsigned<D>(), (std::uint32_t{1} << (23 - m)) - 1)),
+        offset_mask(hn::Set(hn::RebindToUnsigned<D>(), (std::uint32_t{1} << offset_bits) - 1)) {}
+  void place(D d, hn::Vec<D> x, hn::Vec<D>& bucket, hn::Vec<hn::RebindToUnsigned<D>>& above_lo) const {
+    const hn::RebindToUnsigned<D> du;
+    const hn::Rebind<float, D> df;
+    const auto bits = hn::BitCast(du, hn::ConvertTo(df, x));
+    bucket = hn::Max(hn::Sub(hn::BitCast(d, hn::ShiftRightSame(bits, fraction_shift)), first_bucket), hn::Zero(d));
+    above_lo = hn::BitCast(du, hn::Sub(x, hn::ConvertTo(d, hn::BitCast(df, hn::AndNot(below_fraction, bits)))));
+  }
+  hn::Vec<hn::RebindToUnsigned<D>> code(hn::Vec<hn::RebindToUnsigned<D>> word,
+                                        hn::Vec<hn::RebindToUnsigned<D>> above_lo) const {
+    const hn::RebindToUnsigned<D> du;
+    return hn::Add(hn::ShiftRightSame(word, offset_bits),
+                   hn::IfThenZeroElse(hn::Lt(above_lo, hn::And(word, offset_mask)), hn::Set(du, 1u)));
+  }
+  int fraction_shift;
+  int offset_bits;
+  hn::Vec<D> first_bucket;
+  hn::Vec<hn::RebindToUnsigned<D>> below_fraction;
+  hn::Vec<hn::RebindToUnsigned<D>> offset_mask;
+};
+#endif
+
 template <typename Linear>
 std::size_t DriveCodesNarrow([[maybe_unused]] const Linear* linear, [[maybe_unused]] std::size_t n,
                              [[maybe_unused]] const DrivePlan& p, [[maybe_unused]] std::uint16_t* out) {
@@ -493,9 +523,6 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const Linear* linear, [[maybe_unus
   const auto six = hn::Set(d, std::int32_t{6});
   const bool packed = !p.packed32.empty();
   const auto* packed_words = reinterpret_cast<const std::int32_t*>(p.packed32.data());
-  const auto direct = hn::Set(d, std::int32_t{1} << m);
-  const auto one32 = hn::Set(du, 1u);
-  const auto offset_mask = hn::Set(du, packed ? (std::uint32_t{1} << p.offset_bits) - 1 : 0u);
   const std::size_t phase_step = lanes % 3;
   std::size_t phase = 0;
   // x in 32-bit lanes, its octave and its top bits; false where a lane is outside the index (the generic search).
@@ -537,12 +564,9 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const Linear* linear, [[maybe_unus
     HWY_ALIGN std::uint32_t below[kPassChunk];
     std::array<bool, kPassChunk> by_generic_search{};
     const std::int32_t* packed_offset = p.packed_offset32.data();  // locals: a vector store may alias the plan
-    const int offset_bits = p.offset_bits;
-    const int fraction_shift = 23 - m;
+    const FloatBuckets<decltype(d)> buckets(d, m, p.offset_bits);
     const auto keep_all = hn::Set(d, std::int32_t{-1});
     const auto keep_top = hn::Set(d, ~std::int32_t{63});  // from 2^24 (below 2^30): the float's 24 bits
-    const auto below_fraction = hn::Set(du, (std::uint32_t{1} << fraction_shift) - 1);
-    const auto first_bucket = hn::Set(d, std::int32_t{126} << m);
     while (s + lanes <= n) {
       const std::size_t count = pass_chunk(n - s, lanes);
       for (std::size_t i = 0; i < count; i += lanes, phase = next_phase(phase, phase_step)) {
@@ -553,20 +577,19 @@ std::size_t DriveCodesNarrow([[maybe_unused]] const Linear* linear, [[maybe_unus
           hn::Store(hn::Zero(du), du, words + i);
           continue;
         }
+        // x from 2^24 on with its low six bits cleared, so that its float is exact and the bucket unchanged; the bits
+        // above the bucket's lower end are x's own.
         const auto exact = hn::And(x, hn::IfThenElse(hn::Lt(x, exact_float), keep_all, keep_top));
-        const auto bits = hn::BitCast(du, hn::ConvertTo(df, exact));
-        const auto bucket = hn::Max(hn::Sub(hn::BitCast(d, hn::ShiftRightSame(bits, fraction_shift)), first_bucket),
-                                    hn::Zero(d));
+        hn::Vec<decltype(d)> bucket;
+        hn::Vec<decltype(du)> above_lo;
+        buckets.place(d, exact, bucket, above_lo);
         hn::Store(hn::BitCast(du, hn::Add(bucket, hn::LoadU(d, packed_offset + phase))), du, words + i);
-        const auto lo = hn::ConvertTo(d, hn::BitCast(df, hn::AndNot(below_fraction, bits)));
-        hn::Store(hn::BitCast(du, hn::Sub(x, lo)), du, below + i);
+        hn::Store(hn::Add(above_lo, hn::BitCast(du, hn::Sub(x, exact))), du, below + i);
       }
       look_up(reinterpret_cast<const std::uint32_t*>(packed_words), words, count);
       for (std::size_t i = 0; i < count; i += lanes) {
         if (by_generic_search[i]) continue;
-        const auto word = hn::Load(du, words + i);
-        const auto k = hn::ShiftRightSame(word, offset_bits);
-        const auto code = hn::Add(k, hn::IfThenZeroElse(hn::Lt(hn::Load(du, below + i), hn::And(word, offset_mask)), one32));
+        const auto code = buckets.code(hn::Load(du, words + i), hn::Load(du, below + i));
         hn::StoreU(hn::DemoteTo(d16, hn::BitCast(d, code)), d16, out + s + i);
       }
       s += count;
@@ -1031,6 +1054,25 @@ inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const Fix
 }
 
 #if HWY_TARGET != HWY_SCALAR
+// FixedKernels::lcd_drive's unreachable ends, for both lane widths of the kernels: a sum below twice_dark = 2 M(0,
+// v_{t-1})^gamma drives code 0, above twice_bright = 2 M(1, v_{t-1})^gamma the top code, and either contributes
+// 2 M^gamma - x_{t-1}; a sum between them drives the searched code and contributes x_t.
+template <class D>
+struct LcdEnds {
+  LcdEnds(hn::Vec<D> x, hn::Vec<D> x_previous, hn::Vec<D> sum, hn::Vec<D> code, hn::Vec<D> twice_dark,
+          hn::Vec<D> twice_bright, hn::Vec<D> top)
+      : above(hn::Gt(sum, twice_bright)),
+        clamped(hn::Or(hn::Lt(sum, twice_dark), above)),
+        drive(hn::IfThenElse(clamped, hn::IfThenElseZero(above, top), code)),
+        contributed(hn::IfThenElse(clamped, hn::Sub(hn::IfThenElse(above, twice_bright, twice_dark), x_previous), x)) {}
+  hn::Mask<D> above;
+  hn::Mask<D> clamped;
+  hn::Vec<D> drive;
+  hn::Vec<D> contributed;
+};
+#endif
+
+#if HWY_TARGET != HWY_SCALAR
 // The LCD drive of a 32-bit line through LcdPlan::composed, in 32-bit lanes: per sample the composed word and the
 // row's ends (a second word lookup on the eye's first frame, for v_{t-1} from the held row). Vectors with a value
 // outside (-2^29, 2^29) take lcd_scalar: within it the sum, 2 M^gamma - x_{t-1} and the shortfall stay within 32 bits
@@ -1041,7 +1083,6 @@ std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const Lc
                              std::uint16_t* codes, std::int64_t* shortfall, std::uint64_t& unreachable) {
   const hn::ScalableTag<std::int32_t> d;
   const hn::RebindToUnsigned<decltype(d)> du;
-  const hn::Rebind<float, decltype(d)> df;
   const hn::Rebind<std::uint16_t, decltype(d)> d16;
   const hn::Rebind<std::uint8_t, decltype(d)> d8;
   const hn::Half<decltype(d)> dh;
@@ -1050,17 +1091,12 @@ std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const Lc
   // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
   const std::uint32_t* composed = p.composed.data();
   const std::uint64_t* ends = p.ends32.data();
-  const int m = p.composed_mantissa_bits;
-  const int fraction_shift = 23 - m;
-  const int offset_bits = p.composed_offset_bits;
+  const FloatBuckets<decltype(d)> float_buckets(d, p.composed_mantissa_bits, p.composed_offset_bits);
   const int target_shift = p.target_shift;
   const std::int32_t buckets = p.composed_buckets;
   const bool contributed_stored = p.contributed;
   const auto zero = hn::Zero(d);
   const auto top_c = hn::Set(d, std::int32_t{1} << p.target_input_bits);
-  const auto first_bucket = hn::Set(d, std::int32_t{126} << m);
-  const auto below_fraction = hn::Set(du, (std::uint32_t{1} << fraction_shift) - 1);
-  const auto offset_mask = hn::Set(du, (std::uint32_t{1} << offset_bits) - 1);
   const auto row_words = hn::Set(d, buckets);
   const auto held_row = hn::Set(d, static_cast<std::int32_t>(p.width * buckets));
   const auto top = hn::Set(d, p.top);
@@ -1073,10 +1109,7 @@ std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const Lc
     return hn::BitCast(d, hn::PromoteTo(du, hn::LoadU(d8, previous_code + i)));
   };
   // The code from a composed word and c's bits above its bucket's lower end.
-  const auto code_of = [&](const auto word, const auto above_lo) {
-    return hn::BitCast(d, hn::Add(hn::ShiftRightSame(word, offset_bits),
-                                  hn::IfThenZeroElse(hn::Lt(above_lo, hn::And(word, offset_mask)), hn::Set(du, 1u))));
-  };
+  const auto code_of = [&](const auto word, const auto above) { return hn::BitCast(d, float_buckets.code(word, above)); };
   HWY_ALIGN std::uint32_t words[kPassChunk];
   HWY_ALIGN std::uint32_t above_lo[kPassChunk];
   HWY_ALIGN std::int32_t bucket_of[kPassChunk];
@@ -1094,10 +1127,10 @@ std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const Lc
       by_scalar[i] = !hn::AllFalse(d, hn::Or(outside(x), outside(x_previous)));
       const auto sum = hn::Add(x, x_previous);
       const auto c = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), target_shift), top_c);
-      const auto bits = hn::BitCast(du, hn::ConvertTo(df, c));
-      const auto bucket = hn::Max(hn::Sub(hn::BitCast(d, hn::ShiftRightSame(bits, fraction_shift)), first_bucket), zero);
-      const auto lo = hn::ConvertTo(d, hn::BitCast(df, hn::AndNot(below_fraction, bits)));
-      hn::Store(hn::BitCast(du, hn::Sub(c, lo)), du, above_lo + i);
+      hn::Vec<decltype(d)> bucket;
+      hn::Vec<decltype(du)> above;
+      float_buckets.place(d, c, bucket, above);
+      hn::Store(above, du, above_lo + i);
       hn::Store(bucket, d, bucket_of + i);
       const auto row = held ? held_row : hn::Mul(previous_row(s + i), row_words);
       hn::Store(hn::BitCast(du, hn::Add(bucket, row)), du, words + i);
@@ -1128,15 +1161,11 @@ std::size_t LcdDriveComposed(const std::int32_t* wanted, std::size_t n, const Lc
       const auto code = code_of(hn::Load(du, words + i), hn::Load(du, above_lo + i));
       hn::Vec<decltype(du)> dark_bits, bright_bits;
       hn::LoadInterleaved2(du, reinterpret_cast<const std::uint32_t*>(row_ends + i), dark_bits, bright_bits);
-      const auto end_dark = hn::BitCast(d, dark_bits);
-      const auto end_bright = hn::BitCast(d, bright_bits);
-      const auto below = hn::Lt(sum, end_dark);
-      const auto above = hn::Gt(sum, end_bright);
-      const auto clamped = hn::Or(below, above);
-      const auto drive = hn::IfThenElse(clamped, hn::IfThenElseZero(above, top), code);
-      const auto contributed =
-          hn::IfThenElse(clamped, hn::Sub(hn::IfThenElse(above, end_bright, end_dark), x_previous), x);
-      unreachable_lanes = CountInto(d, unreachable_lanes, clamped);
+      const LcdEnds<decltype(d)> ends_rule(x, x_previous, sum, code, hn::BitCast(d, dark_bits),
+                                           hn::BitCast(d, bright_bits), top);
+      const auto drive = ends_rule.drive;
+      const auto contributed = ends_rule.contributed;
+      unreachable_lanes = CountInto(d, unreachable_lanes, ends_rule.clamped);
       if (shortfall != nullptr) {
         const auto gap = hn::Sub(x, contributed);
         hn::StoreU(hn::PromoteTo(d64, hn::LowerHalf(dh, gap)), d64, shortfall + s + i);
@@ -1239,13 +1268,11 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
                           const auto lo) {
     hn::Vec<decltype(d)> end_dark, end_bright;
     LookupPairs(d, ends, j, end_dark, end_bright);
-    const auto below = hn::Lt(sum, hn::Add(end_dark, end_dark));
-    const auto above = hn::Gt(sum, hn::Add(end_bright, end_bright));
-    const auto clamped = hn::Or(below, above);
-    const auto drive = hn::IfThenElse(clamped, hn::IfThenElseZero(above, top), lo);
-    const auto end = hn::IfThenElse(above, end_bright, end_dark);
-    const auto contributed = hn::IfThenElse(clamped, hn::Sub(hn::Add(end, end), x_previous), x);
-    unreachable_lanes = CountInto(d, unreachable_lanes, clamped);
+    const LcdEnds<decltype(d)> ends_rule(x, x_previous, sum, lo, hn::Add(end_dark, end_dark),
+                                         hn::Add(end_bright, end_bright), top);
+    const auto drive = ends_rule.drive;
+    const auto contributed = ends_rule.contributed;
+    unreachable_lanes = CountInto(d, unreachable_lanes, ends_rule.clamped);
     if (shortfall != nullptr) hn::StoreU(hn::Sub(x, contributed), d, shortfall + i);
     const auto stored = contributed_stored ? contributed : x;
     hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, drive)), d16, codes + i);
@@ -2001,10 +2028,6 @@ void packed_drive_search(const std::array<const ThresholdIndex*, 3>& channels, D
   for (int i = 0; i < 3 + DrivePlan::kMaxLanes; ++i) d.packed_offset32.push_back((i % 3) * buckets);
   d.offset_bits = offset_bits;
 }
-
-}  // namespace
-
-namespace {
 
 // Each row's merge thresholds in the target's units (LcdPlan::index), rows of plan.top: U_k = ceil(merge[r][k] /
 // scale), nondecreasing in k and every one in [1, one]; empty where a row's are not.

@@ -16,9 +16,9 @@
 #include "line_ring.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <atomic>
 #include <exception>
 #include <limits>
 #include <memory>
