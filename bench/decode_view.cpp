@@ -5,9 +5,11 @@
 // (a reduced view needs the full view's stores).
 #include "trm/encoder.hpp"
 #include "trm/fixed_decoder.hpp"
+#include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
 
 #include <benchmark/benchmark.h>
+#include <opencv2/core/utility.hpp>
 
 #include <string>
 #include <vector>
@@ -44,7 +46,7 @@ FixedDecoderConfig codes_only(const char* panel, std::int64_t threads) {
   FixedDecoderConfig config;
   config.decoder.link = link_config();
   config.decoder.panel = parse_panel(panel);
-  config.report_planes = false;
+  config.decoder.report_planes = false;
   config.motion_weight_statistics = false;
   config.threads = static_cast<int>(threads);
   return config;
@@ -74,6 +76,37 @@ void BM_DecodeView(benchmark::State& state) {
                  ", " + std::to_string(state.range(1)) + " thread(s)");
 }
 BENCHMARK(BM_DecodeView)
+    ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The double reference's full and reduced views, as `trm bench` times it (its rows split over OpenCV's threads, the
+// three double planes returned). Args: timed view (0 = full, 1 = reduced), threads (OpenCV's), panel (0 = vive, 1 = lcd).
+void BM_ReferenceView(benchmark::State& state) {
+  const std::vector<LinkFrame>& views = pair_of_views();
+  const int threads_before = cv::getNumThreads();
+  cv::setNumThreads(static_cast<int>(state.range(1)));
+  ReferenceDecoder decoder(codes_only(state.range(2) == 0 ? "vive" : "lcd", 1).decoder);
+  const bool timed_reduced = state.range(0) != 0;
+  benchmark::DoNotOptimize(decoder.decode(views[0]));
+  benchmark::DoNotOptimize(decoder.decode(views[1]));
+  for (auto _ : state) {
+    if (timed_reduced) state.PauseTiming();
+    benchmark::DoNotOptimize(decoder.decode(views[0]));
+    if (timed_reduced) {
+      state.ResumeTiming();
+    } else {
+      state.PauseTiming();
+    }
+    benchmark::DoNotOptimize(decoder.decode(views[1]));
+    if (!timed_reduced) state.ResumeTiming();
+  }
+  cv::setNumThreads(threads_before);
+  state.SetItemsProcessed(state.iterations() * kWidth * kHeight);
+  state.SetLabel(std::string(timed_reduced ? "reduced" : "full") + " view, " + (state.range(2) == 0 ? "vive" : "lcd") +
+                 ", " + std::to_string(state.range(1)) + " thread(s)");
+}
+BENCHMARK(BM_ReferenceView)
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -10,9 +10,6 @@
 #include <string>
 #include <utility>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 namespace trm::fixed_detail {
 
@@ -43,38 +40,7 @@ namespace {
   return any_bits != 0;
 }
 
-// How many hold a plane's data. Read with acquire order: a caller lets a view go on a thread of its own (trm feed's
-// sending thread), and its last reads of the plane must come before a reuse writes it.
-int owners(const cv::Mat& m) {
-  return m.u == nullptr ? 0 : std::atomic_ref<int>(m.u->refcount).load(std::memory_order_acquire);
-}
-
-// Held by its owner alone (the spare list): no returned frame, held output or concealment shares it.
-bool unshared(const cv::Mat& m) { return owners(m) == 1; }
-
 }  // namespace
-
-cv::Mat frame_plane(cv::Size size, int type) {
-  cv::Mat plane(size, type);
-#if defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  const auto begin = reinterpret_cast<std::uintptr_t>(plane.data);
-  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t last = (begin + plane.total() * plane.elemSize()) & ~(kHugePage - 1);
-  // Advice only: where the kernel declines it, the plane keeps its 4 KiB pages.
-  if (last > first) (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-#endif
-  return plane;
-}
-
-cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type) {
-  for (const cv::Mat& spare : spares) {
-    if (spare.size() == size && spare.type() == type && unshared(spare)) return spare;
-  }
-  cv::Mat plane = frame_plane(size, type);
-  spares.push_back(plane);
-  return plane;
-}
 
 FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye, bool codes_checked) const {
   FrameOutput out;
@@ -82,13 +48,13 @@ FrameOutput FixedDecoderCore::start_output(const FrameMeta& meta, EyeState& eye,
   out.frame.meta = meta;
   out.frame.meta.width = full.width;
   out.frame.meta.height = full.height;
-  const bool planes = config().report_planes;
+  const bool planes = config().decoder.report_planes;
   // A spare plane is free where the spare list alone holds it, or, for a view whose codes were all checked, the held
   // output (read only for a lost view) besides: that view then takes the held output's planes, and the held output
   // is let go for them (finish holds this view's instead), so that an eye keeps one output where no caller keeps any.
   const DecodedFrame& held = eye.last_output;
   const auto free_plane = [&](const cv::Mat& plane, const cv::Mat& held_plane) {
-    return plane.u != nullptr && owners(plane) == (codes_checked && plane.u == held_plane.u ? 2 : 1);
+    return plane.u != nullptr && plane_owners(plane) == (codes_checked && plane.u == held_plane.u ? 2 : 1);
   };
   // A spare with report planes where they are wanted (and none where not: the held output keeps the codes only).
   const auto fits = [&](const cv::Mat& plane, const cv::Mat& held_plane) {
@@ -136,7 +102,7 @@ void FixedDecoderCore::begin_lcd(FrameOutput& out, EyeState& eye) const {
 
 Raw FixedDecoderCore::emit(FrameOutput& out, EyeState& eye, int y, int x, int ch, Raw wanted) const {
   const int k = 3 * x + ch;
-  const bool planes = config().report_planes;
+  const bool planes = config().decoder.report_planes;
   if (planes) out.frame.wanted_linear.ptr<double>(y)[k] = kernels_.linear_to_double(wanted);
   if (!kernels_.lcd()) {
     const std::uint16_t code = kernels_.drive_code(wanted, ch);
@@ -668,13 +634,7 @@ detail::Arrival FixedDecoderCore::classify(const LinkFrame& frame, std::span<con
 DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* who) {
   detail::check_lost_view(meta, who);
   last_counts_ = FixedStageCounts();
-  DecodedFrame out = detail::hold_lost_view(eyes_[meta.eye], meta);
-  if (!config().report_planes) {  // a black first view comes with planes
-    out.wanted_linear.release();
-    out.drive.release();
-    out.emitted_linear.release();
-  }
-  return out;
+  return detail::hold_lost_view(eyes_[meta.eye], meta, config().decoder.report_planes);
 }
 
 

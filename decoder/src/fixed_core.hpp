@@ -4,6 +4,7 @@
 #pragma once
 
 #include "fixed_kernels.hpp"
+#include "frame_planes.hpp"
 #include "view_arrival.hpp"
 
 #include <algorithm>
@@ -16,6 +17,10 @@
 #include <vector>
 
 namespace trm::fixed_detail {
+
+using detail::frame_plane;
+using detail::plane_owners;
+using detail::reusable_plane;
 
 // Order-independent accumulators of one frame (integers, so both schedules report identical statistics).
 struct FrameTally {
@@ -102,12 +107,6 @@ struct EyeState {
   std::array<BandTimes, 2> band_times;  // of the last reduced [0] and full [1] view decoded in bands
 };
 
-// A new frame-sized plane whose whole 2 MiB spans are advised to the kernel for transparent huge pages (Linux
-// MADV_HUGEPAGE, which Debian's default "madvise" mode needs): its first touch then faults a few 2 MiB pages instead of
-// one 4 KiB page at a time, which a fresh decoder's first views otherwise pay (docs/performance_history.md).
-cv::Mat frame_plane(cv::Size size, int type);
-// A plane of `size` and `type` from `spares` that nothing else holds, else a new frame_plane (kept in `spares`).
-cv::Mat reusable_plane(std::vector<cv::Mat>& spares, cv::Size size, int type);
 
 // Without FixedDecoderConfig::motion_weight_statistics, a reduced line with a residual runs the motion test on the
 // runs of this many pixels that hold a residual sample that is not 0 (FixedDecoderCore::reduced_line).
@@ -343,7 +342,7 @@ class FixedDecoderCore {
   bool line_kernels(const FrameOutput& out) const { return line_values(out) && kernels_.line_plans().drive; }
   // A reduced-frame line's shown values over the whole line, emitted afterwards (emit_line): any panel.
   bool line_values(const FrameOutput& out) const {
-    return kernels_.line_plans().eotf && !config().report_planes && out.taps == nullptr;
+    return kernels_.line_plans().eotf && !config().decoder.report_planes && out.taps == nullptr;
   }
   // The drive codes of a line's shown values: the OLED drive kernel, the LCD drive kernel, else emit per sample in
   // raster order (the LCD's frame stores). shortfall, where not null, receives each sample's LCD shortfall (0 on an

@@ -9,6 +9,7 @@
 // Then the panel inverse (Sec. 4.4): OLED v = x^(1/gamma_c); LCD solves Eq. 7 for v_t given v_{t-1}.
 #include "trm/reference_decoder.hpp"
 
+#include "frame_planes.hpp"
 #include "view_arrival.hpp"
 
 #include "trm/resample.hpp"
@@ -155,7 +156,7 @@ ReferenceDecoder::ReferenceDecoder(DecoderConfig config)
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
   detail::check_lost_view(meta, "ReferenceDecoder");
   EyeState& eye = eyes_[meta.eye];
-  DecodedFrame out = detail::hold_lost_view(eye, meta);
+  DecodedFrame out = detail::hold_lost_view(eye, meta, config_.report_planes);
   eye.previous_low_linear.release();
   return out;
 }
@@ -226,23 +227,34 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   RowTallies tallies(full.height);
 
   // x_t: what this frame should add to the pair, in linear light, within [0, 1]; then the panel drive of it.
-  cv::Mat wanted(full, CV_64FC3);
-  cv::Mat drive(full, CV_64FC3);
-  cv::Mat codes(full, CV_16UC3);
-  cv::Mat emitted(full, CV_64FC3);
+  // Every sample of these planes is written below, so they may be the planes of an earlier view that nothing holds.
+  // Without the report planes, x_t and v_t are rows of scratch (x_t stays a plane where the LCD keeps it as x_{t-1}
+  // or the stages record it) and the emitted light is not computed.
+  const auto plane = [&eye](int type) { return detail::reusable_plane(eye.spare_planes, eye.full_size, type); };
+  const bool planes = config_.report_planes;
+  cv::Mat wanted = planes || history || record ? plane(CV_64FC3) : cv::Mat();
+  cv::Mat drive = planes ? plane(CV_64FC3) : cv::Mat();
+  cv::Mat codes = plane(CV_16UC3);
+  cv::Mat emitted = planes ? plane(CV_64FC3) : cv::Mat();
+  // Row y of a plane, or of a thread's scratch where the view keeps no plane.
+  const auto row_of = [row_len](cv::Mat& m, std::vector<double>& scratch, int y) {
+    if (!m.empty()) return m.ptr<double>(y);
+    scratch.resize(static_cast<std::size_t>(row_len));
+    return scratch.data();
+  };
 
   // LCD history: v_{t-1} and x_{t-1}. The first frame of an eye has none: the panel is taken to have held this same
   // frame, x_{t-1} = x_t and v_{t-1} = the held drive of x_t (M(v, v) = x_t^(1/gamma)), quantised as any shown drive.
   const bool first_lcd_frame = history && eye.previous_drive.empty();
-  cv::Mat previous_drive = first_lcd_frame ? cv::Mat(full, CV_64FC3) : eye.previous_drive;
+  cv::Mat previous_drive = first_lcd_frame ? plane(CV_64FC3) : eye.previous_drive;
   const cv::Mat previous_wanted = first_lcd_frame ? wanted : eye.previous_wanted;
   cv::Mat next_drive;   // v_t as shown, the v_{t-1} of the next frame
   cv::Mat contributed;  // LcdHistory::Contributed: x_t where reachable, x_t_eff where not
   cv::Mat lcd_target;
   cv::Mat lcd_unreachable;
   if (history) {
-    next_drive.create(full, CV_64FC3);
-    if (config_.lcd_history == LcdHistory::Contributed) contributed.create(full, CV_64FC3);
+    next_drive = plane(CV_64FC3);
+    if (config_.lcd_history == LcdHistory::Contributed) contributed = plane(CV_64FC3);
     if (record) {
       lcd_target.create(full, CV_64FC3);
       lcd_unreachable = cv::Mat::zeros(full, CV_8UC3);
@@ -260,11 +272,9 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   // = I for static content. Building on the wanted x_t instead would count the shortfall twice (it is already in
   // rho), leaving the pair shortfall / 2 too bright. Where m was reachable x_t_eff = x_t, so x_t is kept bit for bit.
   // The design's rule (LcdHistory::Wanted, the default) builds on the wanted x_t, as independent implementations do.
-  const auto drive_row = [&](int y, double* residual_row) {
-    const double* x_row = wanted.ptr<double>(y);
-    double* v_row = drive.ptr<double>(y);
+  const auto drive_row = [&](int y, const double* x_row, double* v_row, double* residual_row) {
     std::uint16_t* q_row = codes.ptr<std::uint16_t>(y);
-    double* e_row = emitted.ptr<double>(y);
+    double* e_row = planes ? emitted.ptr<double>(y) : nullptr;
     if (!history) {
       // OLED: v = x^(1/gamma_c), the row's pows a vector at a time (the same doubles as panel.drive per sample).
       panel.oled.drive(std::span<const double>(x_row, static_cast<std::size_t>(row_len)),
@@ -276,8 +286,10 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
         q_row[k] = std::isnan(v) ? std::uint16_t{0} : quantise(v, top);
       }
       if (nan) tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
-      emission_.row(std::span<const std::uint16_t>(q_row, static_cast<std::size_t>(row_len)),
-                    std::span<double>(e_row, static_cast<std::size_t>(row_len)));
+      if (e_row != nullptr) {
+        emission_.row(std::span<const std::uint16_t>(q_row, static_cast<std::size_t>(row_len)),
+                      std::span<double>(e_row, static_cast<std::size_t>(row_len)));
+      }
       return;
     }
     const double* xp_row = previous_wanted.ptr<double>(y);
@@ -317,6 +329,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     }
     if (nan) tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
     tallies.unreachable[static_cast<std::size_t>(y)] = unreachable;
+    if (e_row == nullptr) return;
     // The light of each code after the previous one in a pass of its own, so that the table's loads (512 KiB at
     // 8-bit output, more than a core's L2) are in flight together.
     for (int k = 0; k < row_len; ++k) {
@@ -333,17 +346,19 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     const cv::Mat low_codes = reduce_codes(frame.codes, link);
     const UpsampledLinear low(low_codes, full, link);
     const std::vector<double> linear_of_code = linear_of_codes(link);
-    cv::Mat low_linear(full, CV_64FC3);
-    cv::Mat residual(full, CV_64FC3);
+    cv::Mat low_linear = plane(CV_64FC3);
+    cv::Mat residual = plane(CV_64FC3);
     cv::Mat full_linear = record ? cv::Mat(full, CV_64FC3) : cv::Mat();
     cv::Mat beta = record ? cv::Mat(full, CV_64FC3) : cv::Mat();
     cv::parallel_for_(cv::Range(0, full.height), [&](const cv::Range& rows) {
+      std::vector<double> wanted_scratch;
+      std::vector<double> drive_scratch;
       for (int y = rows.start; y < rows.end; ++y) {
         double* l_row = low_linear.ptr<double>(y);
         low.row(y, l_row);
         const std::uint16_t* c_row = frame.codes.ptr<std::uint16_t>(y);
         const bool intact = static_cast<std::size_t>(y) >= line_intact.size() || line_intact[static_cast<std::size_t>(y)];
-        double* x_row = wanted.ptr<double>(y);
+        double* x_row = row_of(wanted, wanted_scratch, y);
         double* r_row = residual.ptr<double>(y);
         std::size_t clipped = 0;
         for (int k = 0; k < row_len; ++k) {
@@ -359,7 +374,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
           clipped += shown != b ? 1 : 0;
         }
         tallies.clipped[static_cast<std::size_t>(y)] = clipped;
-        drive_row(y, r_row);
+        drive_row(y, x_row, row_of(drive, drive_scratch, y), r_row);
       }
     });
     out.stats.clipped_fraction = static_cast<double>(RowTallies::total(tallies.clipped)) / samples;
@@ -388,21 +403,24 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     // meta.index >= 0 (check_link_frame), so index - 1 cannot overflow.
     const bool residual_applies = eye.have_residual && eye.residual_index == meta.index - 1;
     cv::Mat alpha = record ? cv::Mat(full, CV_64FC3) : cv::Mat();
-    cv::Mat weight = residual_applies ? cv::Mat(full, CV_64FC1) : cv::Mat();
+    cv::Mat weight = residual_applies ? plane(CV_64FC1) : cv::Mat();
     cv::Mat contrast = residual_applies && record ? cv::Mat(full, CV_64FC1) : cv::Mat();
     cv::Mat alpha_unclamped = residual_applies && record ? cv::Mat(full, CV_64FC3) : cv::Mat();
     const double s = config_.sensitivity;
     cv::parallel_for_(cv::Range(0, full.height), [&](const cv::Range& rows) {
       std::vector<double> alpha_buffer(record ? 0 : static_cast<std::size_t>(row_len));
+      std::vector<double> wanted_scratch;
+      std::vector<double> drive_scratch;
       for (int y = rows.start; y < rows.end; ++y) {
         double* a_row = record ? alpha.ptr<double>(y) : alpha_buffer.data();
         alpha_rows.row(y, a_row);
-        double* x_row = wanted.ptr<double>(y);
+        double* x_row = row_of(wanted, wanted_scratch, y);
+        double* v_row = row_of(drive, drive_scratch, y);
         if (!residual_applies) {
           // No full frame just before this one (stream start, lost frame, two reduced in a row): alpha alone.
           // U of values in [0, 1] stays in [0, 1], so the clamp only guards the convention.
           for (int k = 0; k < row_len; ++k) x_row[k] = std::max(std::min(a_row[k], 1.0), 0.0);
-          drive_row(y, nullptr);
+          drive_row(y, x_row, v_row, nullptr);
           continue;
         }
         const double* p_row = eye.previous_low_linear.ptr<double>(y);
@@ -433,7 +451,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
           }
         }
         tallies.clipped[static_cast<std::size_t>(y)] = clipped;
-        drive_row(y, nullptr);
+        drive_row(y, x_row, v_row, nullptr);
       }
     });
     if (residual_applies) {
@@ -492,7 +510,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     if (record) stages.at(Stage::Residual) = eye.residual.clone();
   }
 
-  out.wanted_linear = wanted;
+  if (planes) out.wanted_linear = wanted;
   out.drive = drive;
   out.drive_codes = codes;
   out.emitted_linear = emitted;

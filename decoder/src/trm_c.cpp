@@ -116,7 +116,7 @@ int rows_available(const trm_decoder& d) {
 }
 
 trm_status create(trm::FixedDecoderConfig config, trm_decoder** out) {
-  config.report_planes = false;  // the C API hands out drive codes and statistics only
+  config.decoder.report_planes = false;  // the C API hands out drive codes and statistics only
   try {
     *out = new trm_decoder(std::move(config));  // validates the configuration
     global_error.clear();

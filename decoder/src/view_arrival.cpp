@@ -150,17 +150,19 @@ cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c) {
 
 namespace trm {
 
-DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last) {
+DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last, bool report_planes) {
   const cv::Size full(meta.full_width, meta.full_height);
   DecodedFrame out;
   if (last != nullptr) {
     out = *last;
     out.stages.reset();
   } else {
-    out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
-    out.drive = cv::Mat::zeros(full, CV_64FC3);
     out.drive_codes = cv::Mat::zeros(full, CV_16UC3);
-    out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
+    if (report_planes) {
+      out.wanted_linear = cv::Mat::zeros(full, CV_64FC3);
+      out.drive = cv::Mat::zeros(full, CV_64FC3);
+      out.emitted_linear = cv::Mat::zeros(full, CV_64FC3);
+    }
   }
   out.meta = meta;
   out.meta.width = full.width;

@@ -85,14 +85,14 @@ cv::Mat concealed_codes(const cv::Mat& codes, const Concealment& c);
 // at the new size). The residual belonged to a pair that is now broken and is dropped with the d_t it was built
 // against; the LCD stores keep the drive the panel still shows.
 template <typename EyeState>
-DecodedFrame hold_lost_view(EyeState& eye, const FrameMeta& meta) {
+DecodedFrame hold_lost_view(EyeState& eye, const FrameMeta& meta, bool report_planes) {
   const cv::Size full(meta.full_width, meta.full_height);
   const bool held = eye.full_size == full && !eye.last_output.drive_codes.empty();
   if (!held) {
     eye = EyeState();
     eye.full_size = full;
   }
-  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr);
+  DecodedFrame out = lost_view_output(meta, held ? &eye.last_output : nullptr, report_planes);
   eye.have_residual = false;
   eye.residual.release();
   eye.previous_low.release();

@@ -6,6 +6,8 @@
 #include "trm/transfer.hpp"
 
 #include <cmath>
+#include <cstddef>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -63,12 +65,22 @@ cv::Mat reduce_codes(const cv::Mat& full_codes, const EncoderConfig& config) {
   const int w = reduced_size(full_codes.cols, config.reduction);
   const int h = reduced_size(full_codes.rows, config.reduction);
   const double sigma = config.effective_sigma();
-  const cv::Mat encoded = dequantise(full_codes, config.bits);
-  if (config.resample_space == ResampleSpace::Encoded) {
-    return quantise_reduced(downsample(encoded, w, h, sigma), config.bits);  // Q_b(D(E))
-  }
-  const cv::Mat linear_reduced = downsample(to_linear(encoded, config.transfer), w, h, sigma);
-  return quantise_reduced(to_encoded(linear_reduced, config.transfer), config.bits);  // Q_b(enc(D(lin(E))))
+  // E (or lin(E)) a row at a time as D reads it: no full-size plane of doubles.
+  const DequantisedRows encoded(full_codes, config.bits);
+  const bool linear_space = config.resample_space == ResampleSpace::Linear;
+  const auto row_len = static_cast<std::size_t>(full_codes.cols) * full_codes.channels();
+  const cv::Mat reduced = downsample(
+      full_codes.size(), full_codes.channels(),
+      [&](int y, double* scratch) {
+        encoded.row(y, scratch);
+        if (linear_space) {
+          to_linear(std::span<const double>(scratch, row_len), std::span<double>(scratch, row_len), config.transfer);
+        }
+        return static_cast<const double*>(scratch);
+      },
+      w, h, sigma);
+  if (!linear_space) return quantise_reduced(reduced, config.bits);                    // Q_b(D(E))
+  return quantise_reduced(to_encoded(reduced, config.transfer), config.bits);  // Q_b(enc(D(lin(E))))
 }
 
 TrmEncoder::TrmEncoder(EncoderConfig config) : config_(config) { config_.validate(); }

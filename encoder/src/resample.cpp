@@ -214,12 +214,22 @@ BilinearTap bilinear_tap(int x, int full, int reduced) {
 
 cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, double sigma) {
   if (full.depth() != CV_64F || full.empty()) throw std::invalid_argument("downsample: expected a non-empty CV_64F matrix");
-  require_axis(full.cols, reduced_width, "downsample (width)");
-  require_axis(full.rows, reduced_height, "downsample (height)");
+  return downsample(
+      full.size(), full.channels(), [&full](int y, double*) { return full.ptr<double>(y); }, reduced_width,
+      reduced_height, sigma);
+}
+
+cv::Mat downsample(cv::Size full_size, int channels, const FullRow& full_row, int reduced_width, int reduced_height,
+                   double sigma) {
+  if (full_size.width < 1 || full_size.height < 1 || channels < 1 || channels > CV_CN_MAX) {
+    throw std::invalid_argument("downsample: expected a non-empty frame");
+  }
+  require_axis(full_size.width, reduced_width, "downsample (width)");
+  require_axis(full_size.height, reduced_height, "downsample (height)");
   require_sigma(sigma);
-  const int channels = full.channels();
-  const std::vector<ClampedTaps> col_taps = clamped_gaussian_taps(full.cols, reduced_width, sigma);
-  const std::vector<ClampedTaps> row_taps = clamped_gaussian_taps(full.rows, reduced_height, sigma);
+  const int type = CV_MAKETYPE(CV_64F, channels);
+  const std::vector<ClampedTaps> col_taps = clamped_gaussian_taps(full_size.width, reduced_width, sigma);
+  const std::vector<ClampedTaps> row_taps = clamped_gaussian_taps(full_size.height, reduced_height, sigma);
 
   // Horizontal pass: every full row -> reduced_width samples.
   // Both passes split their output rows over OpenCV's threads: each output sample is one sum in a fixed order, so the
@@ -229,15 +239,16 @@ cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, d
   // phase (sample f j + p of channel c at plane c f + p, index j), so each tap is one contiguous multiply-add over
   // the run that the compiler vectorises. Every output is still 0 + w_0 s_0 + w_1 s_1 + ... in tap order: the same
   // doubles as the per-output loop.
-  const PolyphaseRun run = polyphase_run(col_taps, full.cols, reduced_width);
-  cv::Mat horizontal(full.rows, reduced_width, full.type());
-  cv::parallel_for_(cv::Range(0, full.rows), [&](const cv::Range& rows) {
+  const PolyphaseRun run = polyphase_run(col_taps, full_size.width, reduced_width);
+  cv::Mat horizontal(full_size.height, reduced_width, type);
+  cv::parallel_for_(cv::Range(0, full_size.height), [&](const cv::Range& rows) {
     const int f = run.factor;
     const int run_length = run.hi - run.lo;
-    std::vector<double> planes(f > 0 ? static_cast<std::size_t>(channels) * full.cols : 0);
+    std::vector<double> planes(f > 0 ? static_cast<std::size_t>(channels) * full_size.width : 0);
     std::vector<double> sums(static_cast<std::size_t>(run_length));
+    std::vector<double> scratch(static_cast<std::size_t>(channels) * full_size.width);
     for (int y = rows.start; y < rows.end; ++y) {
-      const double* src = full.ptr<double>(y);
+      const double* src = full_row(y, scratch.data());
       double* dst = horizontal.ptr<double>(y);
       if (f > 0) {
         for (int ch = 0; ch < channels; ++ch) {
@@ -276,7 +287,7 @@ cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, d
   });
 
   // Vertical pass: whole-row multiply-accumulate keeps memory access sequential.
-  cv::Mat reduced(reduced_height, reduced_width, full.type());
+  cv::Mat reduced(reduced_height, reduced_width, type);
   const int row_len = reduced_width * channels;
   cv::parallel_for_(cv::Range(0, reduced_height), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y) {

@@ -205,39 +205,44 @@ cv::Mat quantise_reduced(const cv::Mat& values, int bits) {
   return codes;
 }
 
-cv::Mat dequantise(const cv::Mat& codes, int bits) {
+DequantisedRows::DequantisedRows(const cv::Mat& codes, int bits) : codes_(codes), max_code_((1 << bits) - 1) {
   if (codes.depth() != CV_16U) throw std::invalid_argument("dequantise: expected a CV_16U matrix");
   require_bits(bits);
-  const int max_code = (1 << bits) - 1;
   // Every code's value once (the same division), then a lookup per sample; a view with fewer samples than codes
   // (a small one at 16 bits) divides per sample instead.
-  const bool by_table = codes.total() * static_cast<std::size_t>(codes.channels()) > static_cast<std::size_t>(max_code);
-  std::vector<double> value_of(by_table ? static_cast<std::size_t>(max_code) + 1 : 0);
-  for (std::size_t code = 0; code < value_of.size(); ++code) {
-    value_of[code] = dequantise(static_cast<std::uint16_t>(code), max_code);
+  const bool by_table = codes.total() * static_cast<std::size_t>(codes.channels()) > static_cast<std::size_t>(max_code_);
+  value_of_.resize(by_table ? static_cast<std::size_t>(max_code_) + 1 : 0);
+  for (std::size_t code = 0; code < value_of_.size(); ++code) {
+    value_of_[code] = dequantise(static_cast<std::uint16_t>(code), max_code_);
   }
-  cv::Mat values(codes.size(), CV_MAKETYPE(CV_64F, codes.channels()));
-  const int row_len = codes.cols * codes.channels();
   // Codes above the maximum cannot come from quantise(); they indicate a bit-depth mix-up. Checked before any work,
-  // so that the lookups below, on OpenCV's threads, throw nothing.
+  // so that the rows, read on OpenCV's threads, throw nothing.
+  const int row_len = codes.cols * codes.channels();
   for (int y = 0; y < codes.rows; ++y) {
     const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
-    if (*std::max_element(src, src + row_len) > max_code) {
-      const std::uint16_t first = *std::find_if(src, src + row_len, [&](std::uint16_t c) { return c > max_code; });
+    if (*std::max_element(src, src + row_len) > max_code_) {
+      const std::uint16_t first = *std::find_if(src, src + row_len, [&](std::uint16_t c) { return c > max_code_; });
       throw std::invalid_argument("dequantise: code " + std::to_string(first) + " exceeds " + std::to_string(bits) +
                                   "-bit range");
     }
   }
+}
+
+void DequantisedRows::row(int y, double* out) const {
+  const std::uint16_t* src = codes_.ptr<std::uint16_t>(y);
+  const int row_len = codes_.cols * codes_.channels();
+  if (!value_of_.empty()) {
+    for (int i = 0; i < row_len; ++i) out[i] = value_of_[src[i]];
+  } else {
+    for (int i = 0; i < row_len; ++i) out[i] = dequantise(src[i], max_code_);
+  }
+}
+
+cv::Mat dequantise(const cv::Mat& codes, int bits) {
+  const DequantisedRows rows_of(codes, bits);
+  cv::Mat values(codes.size(), CV_MAKETYPE(CV_64F, codes.channels()));
   cv::parallel_for_(cv::Range(0, codes.rows), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const std::uint16_t* src = codes.ptr<std::uint16_t>(y);
-      double* dst = values.ptr<double>(y);
-      if (by_table) {
-        for (int i = 0; i < row_len; ++i) dst[i] = value_of[src[i]];
-      } else {
-        for (int i = 0; i < row_len; ++i) dst[i] = dequantise(src[i], max_code);
-      }
-    }
+    for (int y = rows.start; y < rows.end; ++y) rows_of.row(y, values.ptr<double>(y));
   });
   return values;
 }

@@ -78,7 +78,7 @@ TEST(FixedConcealment, WithoutMotionStatisticsTheCodesAreTheSameUnderFaults) {
       const EncoderConfig link = link_config(0.5, 0, true);
       const std::vector<LinkFrame> frames = encode_sequence(scene_images("discs", 150, 128, 9), link);
       FixedDecoderConfig measured_config = fixed_config(link, panel);
-      measured_config.report_planes = false;
+      measured_config.decoder.report_planes = false;
       measured_config.threads = threads;
       FixedDecoderConfig fast_config = measured_config;
       fast_config.motion_weight_statistics = false;
@@ -170,7 +170,7 @@ TEST(FixedConcealment, TheHeldOutputGivesItsPlaneToTheNextViewAndSurvivesAReject
   const std::vector<cv::Mat> images = test::scene_images("discs", 64, 48, 6);
   for (const bool streaming : {true, false}) {
     FixedDecoderConfig config = fixed_config(link);
-    config.report_planes = false;
+    config.decoder.report_planes = false;
     std::unique_ptr<HeadsetDecoder> decoder;
     if (streaming) decoder = std::make_unique<FixedStreamingDecoder>(config);
     else decoder = std::make_unique<FixedFrameDecoder>(config);

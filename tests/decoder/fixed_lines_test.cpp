@@ -41,7 +41,7 @@ struct TargetMock {
 
 FixedDecoderConfig with_kernels(FixedDecoderConfig config, bool kernels, bool planes) {
   config.line_kernels = kernels;
-  config.report_planes = planes;
+  config.decoder.report_planes = planes;
   return config;
 }
 

@@ -142,7 +142,7 @@ TEST(FixedSkip, WithoutMotionStatisticsEveryRunHoldingAResidualIsWeighed) {
       const std::vector<LinkFrame> frames = encode_sequence({full, reduced}, link);
       ASSERT_EQ(frames.at(1).meta.parity, Parity::Reduced);
       FixedDecoderConfig with_statistics = fixed_config(link, panel);
-      with_statistics.report_planes = false;  // the line kernels (the report planes' per-sample path weighs every pixel)
+      with_statistics.decoder.report_planes = false;  // the line kernels (the report planes' per-sample path weighs every pixel)
       FixedDecoderConfig without = with_statistics;
       without.motion_weight_statistics = false;
       FixedStreamingDecoder measured(with_statistics);
@@ -180,7 +180,7 @@ TEST(FixedSkip, WithoutMotionStatisticsLinesWithoutResidualSkipTheMotionTest) {
         for (const int threads : {1, 2}) {
           FixedDecoderConfig with_statistics = fixed_config(link, panel);
           with_statistics.decoder.sensitivity = sensitivity;
-          with_statistics.report_planes = planes;
+          with_statistics.decoder.report_planes = planes;
           with_statistics.threads = threads;
           FixedDecoderConfig without = with_statistics;
           without.motion_weight_statistics = false;

@@ -1,6 +1,6 @@
 // Execution settings of the fixed-point decoder that must not change a bit: the streaming decoder's bands of output
 // lines on several threads (FixedDecoderConfig::threads) and the drive codes without the report planes
-// (FixedDecoderConfig::report_planes).
+// (DecoderConfig::report_planes).
 #include "fixed_core.hpp"
 #include "fixed_decoder_test_support.hpp"
 
@@ -116,7 +116,7 @@ TEST(FixedThreads, ViewsWithLostLinesAndLostViewsMatchOnePipeline) {
 TEST(FixedThreads, MoreBandsThanThreadsGiveTheOnePipelineBits) {
   for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
     FixedDecoderConfig config = fixed_config(link_config(0.5, 0, true), panel);
-    config.report_planes = false;  // the line kernels' path, as a feed runs it
+    config.decoder.report_planes = false;  // the line kernels' path, as a feed runs it
     config.motion_weight_statistics = false;
     expect_bands_identical(encode_sequence(scene_images("discs", kWidth, 640, 4), link_config(0.5, 0, true)), config,
                            "tall discs " + panel);
@@ -218,7 +218,7 @@ TEST(FixedThreads, DriveCodesWithoutReportPlanesAreTheSameBits) {
     const auto frames = encode_sequence(scene_images("panorama", kWidth, 96, 4), link);
     FixedDecoderConfig planes = fixed_config(link, panel);
     FixedDecoderConfig codes_only = planes;
-    codes_only.report_planes = false;
+    codes_only.decoder.report_planes = false;
     FixedStreamingDecoder with(planes);
     FixedStreamingDecoder without(codes_only);
     FixedFrameDecoder frame_without(codes_only);

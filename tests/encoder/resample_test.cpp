@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 namespace trm {
 namespace {
@@ -298,6 +299,37 @@ TEST(Downsample, IsTheSeparableSumInTapOrderBitForBit) {
     }
     EXPECT_EQ(differ, 0U) << c.fw << "x" << c.fh << " r=" << c.r << " channels " << c.channels;
   }
+}
+
+// D of a frame given a row at a time (into the scratch it is handed, as reduce_codes gives it) is the same doubles as
+// D of the frame's plane, each row asked for once.
+TEST(Downsample, FromRowsIsTheSameDoublesAsFromThePlane) {
+  struct Case { int fw, fh; double r; int channels; };
+  for (const Case& c : {Case{2160, 6, 0.5, 3}, Case{99, 7, 1.0 / 3.0, 1}, Case{97, 9, 0.5, 3}, Case{12, 5, 0.5, 2}}) {
+    const int w = reduced_size(c.fw, c.r), h = reduced_size(c.fh, c.r);
+    const double sigma = default_sigma(c.r);
+    const cv::Mat full = random_image(c.fw, c.fh, c.channels, 17u + c.fw);
+    std::vector<int> asked(static_cast<std::size_t>(c.fh), 0);
+    const cv::Mat from_rows = downsample(
+        full.size(), c.channels,
+        [&](int y, double* scratch) {
+          ++asked[static_cast<std::size_t>(y)];  // rows are asked for on several threads, each row on one
+          std::memcpy(scratch, full.ptr(y), full.cols * full.elemSize());
+          return static_cast<const double*>(scratch);
+        },
+        w, h, sigma);
+    const cv::Mat from_plane = downsample(full, w, h, sigma);
+    ASSERT_EQ(from_rows.size(), from_plane.size());
+    ASSERT_EQ(from_rows.type(), from_plane.type());
+    for (int y = 0; y < h; ++y) {
+      EXPECT_EQ(std::memcmp(from_rows.ptr(y), from_plane.ptr(y), from_rows.cols * from_rows.elemSize()), 0)
+          << c.fw << "x" << c.fh << " row " << y;
+    }
+    EXPECT_EQ(std::count(asked.begin(), asked.end(), 1), c.fh) << c.fw << "x" << c.fh;
+  }
+  const auto no_row = [](int, double* scratch) { return static_cast<const double*>(scratch); };
+  EXPECT_THROW(downsample(cv::Size(0, 4), 3, no_row, 1, 2, 2.5), std::invalid_argument);
+  EXPECT_THROW(downsample(cv::Size(8, 4), 0, no_row, 4, 2, 2.5), std::invalid_argument);
 }
 
 TEST(Downsample, KeepsConstantsAndAcceptsAnyChannelCount) {

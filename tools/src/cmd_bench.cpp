@@ -122,8 +122,8 @@ std::string formats_label(const std::vector<std::string>& formats) {
 
 // Every contender's name, in the order they are listed; the OpenCV decoder is the yardstick of every ratio and is
 // always timed.
-const std::vector<std::string> kContenders = {"fixed", "fixed-1t", "fixed+planes", "fixed-frame", "reference",
-                                              "opencv-float32"};
+const std::vector<std::string> kContenders = {"fixed",     "fixed-1t",         "fixed+planes",  "fixed-frame",
+                                              "reference", "reference+planes", "opencv-float32"};
 
 BenchSize parse_bench_size(const std::string& text) {
   const bool stereo = !text.empty() && text.back() == 's';
@@ -216,10 +216,10 @@ FixedDecoderConfig config_for(const BenchSize& size, const std::string& panel, c
 // comparison the criterion is judged on: README "Accuracy").
 Json reference_agreement(const FixedDecoderConfig& config, const std::vector<LinkFrame>& views, std::ostream& text) {
   FixedDecoderConfig codes_only = config;  // as the `fixed` contender runs
-  codes_only.report_planes = false;
+  codes_only.decoder.report_planes = false;
   codes_only.motion_weight_statistics = kFixedMotionWeightStatistics;
   const std::unique_ptr<HeadsetDecoder> fixed = make_decoder("fixed", codes_only);
-  const std::unique_ptr<HeadsetDecoder> reference = make_decoder("reference", config);
+  const std::unique_ptr<HeadsetDecoder> reference = make_decoder("reference", codes_only);
   auto* const synchronised = dynamic_cast<ReferenceDecoder*>(reference.get());
   const bool lcd = config.decoder.panel.has_history();
   CodeAgreement codes;
@@ -276,10 +276,11 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   const std::vector<LinkFrame> views = encode_views(size, options, config.decoder.link);
   std::vector<Contender> contenders;
   // The hardware model's output is the drive codes: the streaming decoder without the report planes, on the
-  // machine's threads and on one; then as `trm run` uses it (one thread, report planes), the frame schedule and the
-  // reference, which return the planes. The codes alone need no motion weight statistics either.
+  // machine's threads and on one; then as `trm run` uses it (one thread, report planes) and the frame schedule, which
+  // return the planes. The codes alone need no motion weight statistics either. The reference as the agreement check
+  // and a comparison of codes run it (drive codes, as the OpenCV decoder returns), and as `trm run` does (planes).
   FixedDecoderConfig codes_only = config;
-  codes_only.report_planes = false;
+  codes_only.decoder.report_planes = false;
   codes_only.motion_weight_statistics = kFixedMotionWeightStatistics;
   FixedDecoderConfig banded = codes_only;
   banded.threads = options.threads;
@@ -310,7 +311,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
   add(banded.threads > 1 ? "fixed-1t" : "fixed", "fixed", codes_only);
   add("fixed+planes", "fixed", config);
   add("fixed-frame", "fixed-frame", config);
-  add("reference", "reference", config);
+  add("reference", "reference", codes_only);
+  add("reference+planes", "reference", config);
   contenders.push_back({"opencv-float32", cv::getNumThreads(),
                         [&config] {
                           auto d = std::make_shared<bench::OpencvTrmDecoder>(config.decoder);
@@ -403,8 +405,8 @@ Json bench_one(const BenchSize& size, const std::string& panel, const BenchOptio
        << " MiB on chip + " << hw["off_chip_mib"].get<double>() << " MiB off chip + "
        << hw["output_frame_mib"].get<double>() << " MiB output drive codes = " << hw["total_mib"].get<double>()
        << " MiB (peak RSS includes the process and the encoded views; work = peak less the resident set before the "
-          "decoder was built, after the heap's free pages went back; fixed+planes, fixed-frame and reference also "
-          "return three double planes per view)\n";
+          "decoder was built, after the heap's free pages went back; fixed+planes, fixed-frame and reference+planes "
+          "also return three double planes per view)\n";
   result["decoders"] = std::move(decoders);
   result["reference_agreement"] = reference_agreement(config, views, text);
   return result;

@@ -114,7 +114,7 @@ FixedDecoderConfig fixed_config_of(const PipelineOptions& options) {
   config.decoder.lcd_history = options.lcd_history;
   config.skip_unneeded = !options.no_skip;
   config.threads = options.threads;
-  config.report_planes = options.report_planes;
+  config.decoder.report_planes = options.report_planes;
   config.motion_weight_statistics = options.motion_weight_statistics;
   if (options.residual_bits != 0) config.residual = residual_format_of_bits(options.residual_bits, config.linear_frac_bits);
   return config;

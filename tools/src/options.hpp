@@ -38,7 +38,7 @@ struct PipelineOptions {
   bool no_skip = false;               // fixed impl: run the full path everywhere (FixedDecoderConfig::skip_unneeded)
   LcdHistory lcd_history = LcdHistory::Wanted;
   int threads = 1;                    // fixed impl: FixedDecoderConfig::threads
-  bool report_planes = true;          // fixed impl: FixedDecoderConfig::report_planes (not an option: trm feed,
+  bool report_planes = true;          // DecoderConfig::report_planes (not an option: trm feed,
                                       // whose rig takes the drive codes alone, turns them off)
   bool motion_weight_statistics = true;  // fixed impl: FixedDecoderConfig::motion_weight_statistics (likewise)
 

@@ -37,6 +37,12 @@ struct DecoderConfig {
   int output_bits = 8;         // drive code depth, 8 or 10
   bool record_stages = false;  // fill DecodedFrame::stages (per-stage vectors for golden tests)
   LcdHistory lcd_history = LcdHistory::Wanted;
+  // The report planes of DecodedFrame (wanted_linear, drive, emitted_linear: three full-size CV_64FC3 planes, 3 x
+  // 59 MiB at 2160x1200) besides the drive codes, the hardware's output. false leaves them empty: what a testbench,
+  // a rig feed, a comparison of codes or a throughput run needs; the fixed-point LCD's report drive value (a division
+  // per sample) and the reference's emitted light are then not computed. Like record_stages, a run-time choice: the
+  // codes and statistics are the same either way.
+  bool report_planes = true;
 
   void validate() const;       // throws std::invalid_argument with a clear message
 };
@@ -105,8 +111,9 @@ struct DecodedFrame {
 };
 
 // What any decoder shows for a view that never arrived (DESIGN §4): `last`, this eye's previous output at the same
-// view size, again; or black when there is none (null). Marked lost, every line counted as concealed.
-DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last);
+// view size, again; or black when there is none (null), its report planes only where they are wanted
+// (DecoderConfig::report_planes). Marked lost, every line counted as concealed.
+DecodedFrame lost_view_output(const FrameMeta& meta, const DecodedFrame* last, bool report_planes = true);
 
 struct FixedDecoderConfig;
 struct FixedStageCounts;

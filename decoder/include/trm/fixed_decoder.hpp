@@ -156,10 +156,6 @@ struct FixedDecoderConfig {
 
   // Execution settings: how the model runs, not what it computes (the codes and statistics are the same bits for
   // every value; they are not part of fixed_decoder_json).
-  // The report planes of DecodedFrame (wanted_linear, drive, emitted_linear: three full-size CV_64FC3 planes, 3 x
-  // 59 MiB at 2160x1200) besides the drive codes, the hardware's output. false leaves them empty: what a testbench,
-  // a rig feed or a throughput run needs; the LCD's report drive value (a division per sample) is then not computed.
-  bool report_planes = true;
   // The frame's mean motion weight and weight-underflow count over every pixel of a reduced frame. Where a pixel's
   // residual is zero w weighs nothing (alpha' = clamp(alpha)), and the motion test runs there only for these
   // statistics. false skips it there, with U of d_{t-1} and its reads, as a controller without these counters

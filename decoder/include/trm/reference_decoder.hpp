@@ -53,6 +53,7 @@ class ReferenceDecoder : public HeadsetDecoder {
     DecodedFrame last_output;  // what this eye showed last, held when a view is lost
     cv::Mat previous_wanted;   // LCD: x_{t-1}, what frame t-1 contributed in linear light: the wanted value,
                                // or 2 M(v_{t-1}, v_{t-2})^gamma - x_{t-2} where that was unreachable
+    std::vector<cv::Mat> spare_planes;  // planes of earlier views, filled again once nothing else holds them
   };
   // Decodes a view whose lost lines (line_intact[y] == 0; empty: none lost) were already filled in.
   DecodedFrame decode_view(const LinkFrame& frame, std::span<const std::uint8_t> line_intact);

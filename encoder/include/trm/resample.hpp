@@ -3,6 +3,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <vector>
 
 namespace trm {
@@ -39,6 +40,12 @@ BilinearTap bilinear_tap(int x, int full, int reduced);
 
 // D: full (CV_64F, any channels) -> reduced size w x h.
 cv::Mat downsample(const cv::Mat& full, int reduced_width, int reduced_height, double sigma);
+// D of a frame that comes a row at a time: full_row(y, scratch) gives row y (full_size.width x channels doubles),
+// either a pointer into a plane the caller keeps or `scratch` filled with the row. The same doubles as downsample()
+// of the frame those rows make, without a full-size plane of it. Rows are asked for on OpenCV's threads, each once.
+using FullRow = std::function<const double*(int y, double* scratch)>;
+cv::Mat downsample(cv::Size full_size, int channels, const FullRow& full_row, int reduced_width, int reduced_height,
+                   double sigma);
 // U: reduced (CV_64F, any channels) -> full size W x H.
 cv::Mat upsample(const cv::Mat& reduced, int full_width, int full_height);
 // U in two parts, for callers that consume it a row at a time: the horizontal pass of every reduced row (reduced

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace trm {
 
@@ -46,6 +47,19 @@ cv::Mat quantise_reduced(const cv::Mat& values, int bits);
 cv::Mat dequantise(const cv::Mat& codes, int bits);
 // The same for one code, with max_code = 2^bits - 1.
 inline double dequantise(std::uint16_t code, int max_code) { return code / static_cast<double>(max_code); }
+// dequantise() a row at a time, for a caller that consumes the values row by row and needs no plane of them: the
+// codes are checked when it is made (throwing as dequantise() does), and row(y, out) writes row y's cols x channels
+// values, the same doubles. row() may be called from several threads at once.
+class DequantisedRows {
+ public:
+  DequantisedRows(const cv::Mat& codes, int bits);
+  void row(int y, double* out) const;
+
+ private:
+  cv::Mat codes_;
+  int max_code_;
+  std::vector<double> value_of_;  // every code's value, when the codes outnumber the values
+};
 
 // Rec. 709 luma on linear RGB: Y = 0.2126 R + 0.7152 G + 0.0722 B (CV_64FC3 -> CV_64FC1).
 cv::Mat luma(const cv::Mat& linear_rgb);

@@ -1,0 +1,138 @@
+// The double reference's run-time choices and its planes: without the report planes it gives the same codes and
+// statistics, and the planes it fills again for later views are never ones a caller still holds.
+#include "decoder_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace trm {
+namespace {
+
+// Content whose left half moves and right half stands still, so that the residual, the motion test and the clamps
+// all take part.
+cv::Mat moving_frame(std::int64_t t) {
+  const cv::Mat source = test::random_image(96, 40, 20261207);
+  cv::Mat frame = source.clone();
+  const int shift = static_cast<int>(3 * t) % 48;
+  for (int y = 0; y < frame.rows; ++y) {
+    for (int x = 0; x < 48; ++x) frame.at<cv::Vec3d>(y, x) = source.at<cv::Vec3d>(y, (x + shift) % 48);
+  }
+  return frame;
+}
+
+void expect_same_stats(const FrameStats& a, const FrameStats& b, const std::string& where) {
+  EXPECT_EQ(a.clipped_fraction, b.clipped_fraction) << where;
+  EXPECT_EQ(a.residual_mean_abs, b.residual_mean_abs) << where;
+  EXPECT_EQ(a.residual_max_abs, b.residual_max_abs) << where;
+  EXPECT_EQ(a.dropped_sum, b.dropped_sum) << where;
+  EXPECT_EQ(a.mean_motion_weight, b.mean_motion_weight) << where;
+  EXPECT_EQ(a.residual_applied, b.residual_applied) << where;
+  EXPECT_EQ(a.lcd_unreachable_fraction, b.lcd_unreachable_fraction) << where;
+  EXPECT_EQ(a.frame_lost, b.frame_lost) << where;
+}
+
+// A stream with a lost first view (black), full and reduced views, and a lost view in the middle (held).
+DecodedFrame decode_step(ReferenceDecoder& decoder, const TrmEncoder& encoder, std::int64_t t) {
+  if (t == 0 || t == 5) {
+    FrameMeta meta = encoder.encode(moving_frame(t), t).meta;
+    return decoder.decode_lost(meta);
+  }
+  return decoder.decode(encoder.encode(moving_frame(t), t));
+}
+
+TEST(ReferenceDecoder, WithoutReportPlanesGivesTheSameCodesAndStatistics) {
+  for (const char* panel : {"vive", "lcd"}) {
+    for (const bool record : {false, true}) {
+      EncoderConfig link;
+      DecoderConfig with_planes = test::decoder_config(link, panel);
+      with_planes.record_stages = record;
+      DecoderConfig codes_only = with_planes;
+      codes_only.report_planes = false;
+      ReferenceDecoder planes_decoder(with_planes);
+      ReferenceDecoder codes_decoder(codes_only);
+      const TrmEncoder encoder(link);
+      for (std::int64_t t = 0; t < 9; ++t) {
+        const std::string where = std::string(panel) + (record ? ", stages" : "") + ", t = " + std::to_string(t);
+        const DecodedFrame a = decode_step(planes_decoder, encoder, t);
+        const DecodedFrame b = decode_step(codes_decoder, encoder, t);
+        ASSERT_FALSE(a.wanted_linear.empty()) << where;
+        ASSERT_FALSE(a.drive.empty()) << where;
+        ASSERT_FALSE(a.emitted_linear.empty()) << where;
+        EXPECT_TRUE(b.wanted_linear.empty()) << where;
+        EXPECT_TRUE(b.drive.empty()) << where;
+        EXPECT_TRUE(b.emitted_linear.empty()) << where;
+        ASSERT_EQ(b.drive_codes.size(), a.drive_codes.size()) << where;
+        EXPECT_EQ(cv::norm(a.drive_codes, b.drive_codes, cv::NORM_INF), 0.0) << where;
+        expect_same_stats(a.stats, b.stats, where);
+        ASSERT_EQ(a.stages.has_value(), b.stages.has_value()) << where;
+        if (a.stages) {
+          for (std::size_t s = 0; s < a.stages->planes.size(); ++s) {
+            const cv::Mat& pa = a.stages->planes[s];
+            const cv::Mat& pb = b.stages->planes[s];
+            ASSERT_EQ(pa.empty(), pb.empty()) << where << ", stage " << s;
+            if (!pa.empty()) {
+              EXPECT_EQ(cv::norm(pa, pb, cv::NORM_INF), 0.0) << where << ", stage " << s;
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(ReferenceDecoder, FillsAgainOnlyThePlanesNoCallerHolds) {
+  for (const char* panel : {"vive", "lcd"}) {
+    EncoderConfig link;
+    DecoderConfig config = test::decoder_config(link, panel);
+    config.record_stages = false;
+    const TrmEncoder encoder(link);
+    // Every view kept: each keeps the samples it had when it was returned.
+    {
+      ReferenceDecoder decoder(config);
+      std::vector<DecodedFrame> kept;
+      std::vector<DecodedFrame> copies;
+      for (std::int64_t t = 1; t < 9; ++t) {
+        kept.push_back(decoder.decode(encoder.encode(moving_frame(t), t)));
+        DecodedFrame copy = kept.back();
+        copy.wanted_linear = copy.wanted_linear.clone();
+        copy.drive = copy.drive.clone();
+        copy.drive_codes = copy.drive_codes.clone();
+        copy.emitted_linear = copy.emitted_linear.clone();
+        copies.push_back(copy);
+      }
+      for (std::size_t i = 0; i < kept.size(); ++i) {
+        const std::string where = std::string(panel) + ", view " + std::to_string(i);
+        EXPECT_EQ(cv::norm(kept[i].wanted_linear, copies[i].wanted_linear, cv::NORM_INF), 0.0) << where;
+        EXPECT_EQ(cv::norm(kept[i].drive, copies[i].drive, cv::NORM_INF), 0.0) << where;
+        EXPECT_EQ(cv::norm(kept[i].drive_codes, copies[i].drive_codes, cv::NORM_INF), 0.0) << where;
+        EXPECT_EQ(cv::norm(kept[i].emitted_linear, copies[i].emitted_linear, cv::NORM_INF), 0.0) << where;
+      }
+    }
+    // No view kept: after the first views, every output lands in memory an earlier view used (no new planes), and
+    // the codes are those of a decoder whose views were all kept.
+    {
+      ReferenceDecoder reusing(config);
+      ReferenceDecoder keeping(config);
+      std::vector<DecodedFrame> kept;
+      std::set<const uchar*> seen;
+      int fresh_after_warm_up = 0;
+      for (std::int64_t t = 1; t < 13; ++t) {
+        const LinkFrame view = encoder.encode(moving_frame(t), t);
+        const DecodedFrame d = reusing.decode(view);
+        kept.push_back(keeping.decode(view));
+        EXPECT_EQ(cv::norm(d.drive_codes, kept.back().drive_codes, cv::NORM_INF), 0.0) << panel << ", t = " << t;
+        for (const cv::Mat* m : {&d.wanted_linear, &d.drive, &d.drive_codes, &d.emitted_linear}) {
+          if (seen.insert(m->data).second && t > 4) ++fresh_after_warm_up;
+        }
+      }
+      EXPECT_EQ(fresh_after_warm_up, 0) << panel;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace trm
