@@ -80,8 +80,8 @@ BENCHMARK(BM_DecodeView)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-// The double reference's full and reduced views, as `trm bench` times it (its rows split over OpenCV's threads, the
-// three double planes returned). Args: timed view (0 = full, 1 = reduced), threads (OpenCV's), panel (0 = vive, 1 = lcd).
+// The double reference's full and reduced views, as `trm bench` times it (its rows split over OpenCV's threads, drive
+// codes only). Args: timed view (0 = full, 1 = reduced), threads (OpenCV's), panel (0 = vive, 1 = lcd).
 void BM_ReferenceView(benchmark::State& state) {
   const std::vector<LinkFrame>& views = pair_of_views();
   const int threads_before = cv::getNumThreads();
