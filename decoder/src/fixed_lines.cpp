@@ -2110,23 +2110,66 @@ void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target) {
     return c >= top_c ? plan.one : target.evaluate_raw(static_cast<std::uint32_t>(c));
   };
   if (target_of(top_c - 1) > plan.one) return;
-  // C_k per row: the least c with target(c) >= U_k (U_k <= one = target(2^input_bits), so there is one).
+  // C_k per row: the least c with target(c) >= U_k (U_k <= one = target(2^input_bits), so there is one), and not below
+  // C_{k-1}. The target at every 2^grid_shift-th c first (and at top_c): every row's thresholds ask the same function.
+  // Between two grid points the target is close to their line, so each search starts at the line's c and widens by
+  // doubling steps to a bracket, then bisects it: a few evaluations where a bisection over the grid's step takes
+  // grid_shift.
+  const int grid_shift = std::max(0, input_bits - 10);
+  std::vector<std::int64_t> grid(static_cast<std::size_t>((top_c >> grid_shift) + 1));
+  for (std::size_t j = 0; j < grid.size(); ++j) grid[j] = target_of(static_cast<std::int64_t>(j) << grid_shift);
+  // The least c in [lo, hi] whose target reaches u, where the target at hi reaches it and at lo - 1 does not.
+  const auto least_reaching = [&](std::int64_t lo, std::int64_t hi, std::int64_t guess, std::int64_t u) {
+    guess = std::clamp(guess, lo, hi);
+    if (target_of(guess) >= u) {
+      hi = guess;
+      for (std::int64_t step = 1; hi - step >= lo; step *= 2) {
+        if (target_of(hi - step) < u) {
+          lo = hi - step + 1;
+          break;
+        }
+        hi -= step;
+      }
+    } else {
+      lo = guess + 1;
+      for (std::int64_t step = 1; lo + step - 1 < hi; step *= 2) {
+        if (target_of(lo + step - 1) >= u) {
+          hi = lo + step - 1;
+          break;
+        }
+        lo += step;
+      }
+    }
+    while (lo < hi) {
+      const std::int64_t mid = lo + (hi - lo) / 2;
+      if (target_of(mid) >= u) {
+        hi = mid;
+      } else {
+        lo = mid + 1;
+      }
+    }
+    return lo;
+  };
   std::vector<std::int64_t> least_c(thresholds.size());
   for (std::int64_t r = 0; r < rows; ++r) {
     std::int64_t from = 0;
     for (std::int64_t k = 0; k < plan.top; ++k) {
       const std::size_t at = static_cast<std::size_t>(r * plan.top + k);
-      std::int64_t lo = from;
-      std::int64_t hi = top_c;
-      while (lo < hi) {
-        const std::int64_t mid = lo + (hi - lo) / 2;
-        if (target_of(mid) >= thresholds[at]) {
-          hi = mid;
-        } else {
-          lo = mid + 1;
+      const std::int64_t u = thresholds[at];
+      // The first grid point that reaches U_k; none (U_k above one): top_c, as a search up to it gives.
+      const auto reached = std::lower_bound(grid.begin(), grid.end(), u);
+      const std::int64_t j = reached - grid.begin();
+      std::int64_t c = top_c;
+      if (reached != grid.end()) {
+        c = 0;
+        if (j > 0) {
+          const std::int64_t below = grid[static_cast<std::size_t>(j - 1)];  // < u <= *reached
+          const std::int64_t base = (j - 1) << grid_shift;
+          const std::int64_t along = ((u - below) << grid_shift) + (*reached - below) - 1;
+          c = least_reaching(base + 1, j << grid_shift, base + along / (*reached - below), u);
         }
       }
-      least_c[at] = from = lo;
+      least_c[at] = from = std::max(from, c);
     }
   }
   // The unreachable ends of the sums, in 32 bits.
@@ -2137,24 +2180,49 @@ void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target) {
     if (dark < 0 || bright < 0 || dark > (std::int64_t{1} << 30) || bright > (std::int64_t{1} << 30)) return;
     ends[v] = static_cast<std::uint64_t>(dark) | (static_cast<std::uint64_t>(bright) << 32);
   }
+  // Whether, with m fraction bits, no bucket holds two of a row's C_k above its lower end (float_bucket's buckets: one
+  // value below 2^m, else the values sharing c's top m + 1 bits): the table's condition, asked before it is built.
+  const auto fits_buckets = [&](int m) {
+    for (std::int64_t r = 0; r < rows; ++r) {
+      const std::int64_t* c_k = least_c.data() + r * plan.top;
+      for (std::int64_t k = 0; k + 1 < plan.top; ++k) {
+        const std::int64_t c = c_k[k];
+        const int e = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(c))) - 1;
+        if (e < m) continue;
+        const std::int64_t width = std::int64_t{1} << (e - m);
+        const std::int64_t lo = c & ~(width - 1);
+        if (c != lo && c_k[k + 1] < lo + width) return false;
+      }
+    }
+    return true;
+  };
   const int code_bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(plan.top)));
   for (int m = 6; m <= 10; ++m) {
     const int offset_bits = input_bits - m + 1;  // a bucket is at most 2^(input_bits - m) wide
     const std::int32_t buckets = (input_bits + 2) << m;
     if (offset_bits < 1 || offset_bits + code_bits > 32 ||
         static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets) * sizeof(std::uint32_t) >
-            LcdPlan::kMaxComposedBytes) {
+            LcdPlan::kMaxComposedBytes ||
+        !fits_buckets(m)) {
       continue;
+    }
+    // The buckets every row has: index, lower end and width of each that some c in [0, top_c] addresses.
+    struct Bucket {
+      std::int32_t index;
+      std::int64_t lo;
+      std::int64_t width;
+    };
+    std::vector<Bucket> addressed;
+    for (std::int32_t b = 0; b < buckets; ++b) {
+      Bucket bucket{b, 0, 1};
+      if (float_bucket(b, m, bucket.lo, bucket.width) && bucket.lo <= top_c) addressed.push_back(bucket);
     }
     std::vector<std::uint32_t> composed(static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets), 0);
     bool fits = true;
     for (std::int64_t r = 0; r < rows && fits; ++r) {
       const std::int64_t* c_k = least_c.data() + r * plan.top;
       std::int64_t code = 0;  // C_k at or below the bucket's lower end
-      for (std::int32_t b = 0; b < buckets; ++b) {
-        std::int64_t lo = 0;
-        std::int64_t width = 1;
-        if (!float_bucket(b, m, lo, width) || lo > top_c) continue;
+      for (const auto& [b, lo, width] : addressed) {
         while (code < plan.top && c_k[code] <= lo) ++code;
         if (code + 1 < plan.top && c_k[code + 1] < lo + width) {  // two inside: too coarse
           fits = false;
