@@ -68,6 +68,18 @@ def test_each_eye_keeps_its_own_state(views):
                 np.testing.assert_array_equal(alone.decode(view).drive_codes, out.drive_codes)
 
 
+@pytest.mark.parametrize("name", ["reference", "fixed", "fixed-frame"])
+def test_without_report_planes_the_codes_are_the_same(views, name):
+    with_planes, codes_only = trm.Decoder(name), trm.Decoder(name, report_planes=False)
+    for view in views:
+        a, b = with_planes.decode(view), codes_only.decode(view)
+        assert a.drive is not None and a.wanted_linear is not None and a.emitted_linear is not None
+        assert b.drive is None and b.wanted_linear is None and b.emitted_linear is None
+        np.testing.assert_array_equal(a.drive_codes, b.drive_codes)
+        assert a.stats == b.stats
+    assert codes_only.decode_lost(views[0]).drive is None
+
+
 def test_a_lost_view_holds_the_previous_output(views):
     decoder = trm.Decoder("fixed")
     shown = decoder.decode(views[0])

@@ -206,10 +206,18 @@ View make_view(const py::handle& codes, std::int64_t t, const std::string& parit
 
 // The GIL is released while a decoder runs (other Python threads, other decoders, go on); the lock keeps two threads
 // from running one decoder, whose per-eye state is not for concurrent use, at once.
+// A report plane of a decoded view, or None where the decoder was made without them.
+py::object report_plane(const cv::Mat& plane) { return plane.empty() ? py::object(py::none()) : py::object(share_image(plane)); }
+
+FixedDecoderConfig with_report_planes(FixedDecoderConfig config, bool report_planes) {
+  config.decoder.report_planes = report_planes;
+  return config;
+}
+
 class Decoder {
  public:
-  Decoder(const std::string& name, const py::object& config)
-      : config_(fixed_config_of(config)), decoder_(make_decoder(name, config_)) {}
+  Decoder(const std::string& name, const py::object& config, bool report_planes)
+      : config_(with_report_planes(fixed_config_of(config), report_planes)), decoder_(make_decoder(name, config_)) {}
 
   std::string name() const { return decoder_->name(); }
   py::object config() const { return python_of(fixed_decoder_json(config_)); }
@@ -425,22 +433,27 @@ PYBIND11_MODULE(trm, m) {
   py::class_<Decoded>(m, "Decoded", "One decoded view: what the panel is driven with and emits.")
       .def_property_readonly("drive_codes", [](const Decoded& d) { return share_image(d.frame.drive_codes); },
                              "HxWx3 uint16 panel drive codes (output_bits).")
-      .def_property_readonly("drive", [](const Decoded& d) { return share_image(d.frame.drive); },
-                             "HxWx3 float64 drive values v in [0, 1] before output quantisation.")
-      .def_property_readonly("wanted_linear", [](const Decoded& d) { return share_image(d.frame.wanted_linear); },
-                             "HxWx3 float64: clamp(beta) for a full view, alpha' for a reduced one.")
-      .def_property_readonly("emitted_linear", [](const Decoded& d) { return share_image(d.frame.emitted_linear); },
-                             "HxWx3 float64 light the panel emits from the quantised drive.")
+      .def_property_readonly("drive", [](const Decoded& d) { return report_plane(d.frame.drive); },
+                             "HxWx3 float64 drive values v in [0, 1] before output quantisation (None without "
+                             "report planes).")
+      .def_property_readonly("wanted_linear", [](const Decoded& d) { return report_plane(d.frame.wanted_linear); },
+                             "HxWx3 float64: clamp(beta) for a full view, alpha' for a reduced one (None without "
+                             "report planes).")
+      .def_property_readonly("emitted_linear", [](const Decoded& d) { return report_plane(d.frame.emitted_linear); },
+                             "HxWx3 float64 light the panel emits from the quantised drive (None without report "
+                             "planes).")
       .def_property_readonly("stats", [](const Decoded& d) { return stats_of(d.frame.stats); })
       .def_property_readonly("t", [](const Decoded& d) { return d.frame.meta.index; })
       .def_property_readonly("eye", [](const Decoded& d) { return d.frame.meta.eye; })
       .def_property_readonly("parity", [](const Decoded& d) { return std::string(to_string(d.frame.meta.parity)); });
 
   py::class_<Decoder>(m, "Decoder", "A headset decoder with per-eye state across calls.")
-      .def(py::init<const std::string&, const py::object&>(), py::arg("name"), py::arg("config") = py::none(),
+      .def(py::init<const std::string&, const py::object&, bool>(), py::arg("name"), py::arg("config") = py::none(),
+           py::kw_only(), py::arg("report_planes") = true,
            "name: 'reference', 'fixed' (streaming, the hardware model) or 'fixed-frame'. config: None, a dict in "
            "default_decoder_config() form (as report.json's parameters.decoder) or in its 'decoder' block's form; "
-           "fields left out keep their defaults.")
+           "fields left out keep their defaults. report_planes=False: drive codes and statistics only (drive, "
+           "wanted_linear and emitted_linear are None), the same codes in less time and memory.")
       .def_property_readonly("name", &Decoder::name)
       .def_property_readonly("config", &Decoder::config, "The whole configuration (default_decoder_config() form).")
       .def("decode", &Decoder::decode, py::arg("view"), py::arg("line_intact") = py::none(),
