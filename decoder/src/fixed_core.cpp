@@ -3,13 +3,11 @@
 #include "fixed_core.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
-
 
 namespace trm::fixed_detail {
 
@@ -636,6 +634,5 @@ DecodedFrame FixedDecoderCore::decode_lost(const FrameMeta& meta, const char* wh
   last_counts_ = FixedStageCounts();
   return detail::hold_lost_view(eyes_[meta.eye], meta, config().decoder.report_planes);
 }
-
 
 }  // namespace trm::fixed_detail

@@ -107,7 +107,6 @@ struct EyeState {
   std::array<BandTimes, 2> band_times;  // of the last reduced [0] and full [1] view decoded in bands
 };
 
-
 // Without FixedDecoderConfig::motion_weight_statistics, a reduced line with a residual runs the motion test on the
 // runs of this many pixels that hold a residual sample that is not 0 (FixedDecoderCore::reduced_line).
 inline constexpr std::size_t kMotionRunPixels = 64;

@@ -2110,7 +2110,7 @@ void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target) {
     return c >= top_c ? plan.one : target.evaluate_raw(static_cast<std::uint32_t>(c));
   };
   if (target_of(top_c - 1) > plan.one) return;
-  // C_k per row: the least c with target(c) >= U_k (U_k <= one = target(2^input_bits), so there is one), and not below
+  // C_k per row: the least c with target(c) >= U_k (top_c, whose target is one, for a U_k above one), and not below
   // C_{k-1}. The target at every 2^grid_shift-th c first (and at top_c): every row's thresholds ask the same function.
   // Between two grid points the target is close to their line, so each search starts at the line's c and widens by
   // doubling steps to a bracket, then bisects it: a few evaluations where a bisection over the grid's step takes
@@ -2197,50 +2197,48 @@ void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target) {
     return true;
   };
   const int code_bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(plan.top)));
-  for (int m = 6; m <= 10; ++m) {
+  // The coarsest addressing whose words hold a code and an offset, whose table is not too large, and whose buckets
+  // each hold at most one C_k above the lower end.
+  const auto usable = [&](int m) {
     const int offset_bits = input_bits - m + 1;  // a bucket is at most 2^(input_bits - m) wide
     const std::int32_t buckets = (input_bits + 2) << m;
-    if (offset_bits < 1 || offset_bits + code_bits > 32 ||
-        static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets) * sizeof(std::uint32_t) >
-            LcdPlan::kMaxComposedBytes ||
-        !fits_buckets(m)) {
-      continue;
-    }
-    // The buckets every row has: index, lower end and width of each that some c in [0, top_c] addresses.
-    struct Bucket {
-      std::int32_t index;
-      std::int64_t lo;
-      std::int64_t width;
-    };
-    std::vector<Bucket> addressed;
-    for (std::int32_t b = 0; b < buckets; ++b) {
-      Bucket bucket{b, 0, 1};
-      if (float_bucket(b, m, bucket.lo, bucket.width) && bucket.lo <= top_c) addressed.push_back(bucket);
-    }
-    std::vector<std::uint32_t> composed(static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets), 0);
-    bool fits = true;
-    for (std::int64_t r = 0; r < rows && fits; ++r) {
-      const std::int64_t* c_k = least_c.data() + r * plan.top;
-      std::int64_t code = 0;  // C_k at or below the bucket's lower end
-      for (const auto& [b, lo, width] : addressed) {
-        while (code < plan.top && c_k[code] <= lo) ++code;
-        if (code + 1 < plan.top && c_k[code + 1] < lo + width) {  // two inside: too coarse
-          fits = false;
-          break;
-        }
-        const std::int64_t next = code < plan.top ? std::min(c_k[code] - lo, width) : width;
-        composed[static_cast<std::size_t>(r * buckets + b)] =
-            (static_cast<std::uint32_t>(code) << offset_bits) | static_cast<std::uint32_t>(next);
-      }
-    }
-    if (!fits) continue;
-    plan.composed = std::move(composed);
-    plan.composed_mantissa_bits = m;
-    plan.composed_offset_bits = offset_bits;
-    plan.composed_buckets = buckets;
-    plan.ends32 = std::move(ends);
-    return;
+    return offset_bits >= 1 && offset_bits + code_bits <= 32 &&
+           static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets) * sizeof(std::uint32_t) <=
+               LcdPlan::kMaxComposedBytes &&
+           fits_buckets(m);
+  };
+  int m = 6;
+  while (m <= 10 && !usable(m)) ++m;
+  if (m > 10) return;
+  const int offset_bits = input_bits - m + 1;
+  const std::int32_t buckets = (input_bits + 2) << m;
+  // The buckets every row has: index, lower end and width of each that some c in [0, top_c] addresses.
+  struct Bucket {
+    std::int32_t index;
+    std::int64_t lo;
+    std::int64_t width;
+  };
+  std::vector<Bucket> addressed;
+  for (std::int32_t b = 0; b < buckets; ++b) {
+    Bucket bucket{b, 0, 1};
+    if (float_bucket(b, m, bucket.lo, bucket.width) && bucket.lo <= top_c) addressed.push_back(bucket);
   }
+  std::vector<std::uint32_t> composed(static_cast<std::size_t>(rows) * static_cast<std::size_t>(buckets), 0);
+  for (std::int64_t r = 0; r < rows; ++r) {
+    const std::int64_t* c_k = least_c.data() + r * plan.top;
+    std::int64_t code = 0;  // C_k at or below the bucket's lower end
+    for (const auto& [b, lo, width] : addressed) {
+      while (code < plan.top && c_k[code] <= lo) ++code;
+      const std::int64_t next = code < plan.top ? std::min(c_k[code] - lo, width) : width;
+      composed[static_cast<std::size_t>(r * buckets + b)] =
+          (static_cast<std::uint32_t>(code) << offset_bits) | static_cast<std::uint32_t>(next);
+    }
+  }
+  plan.composed = std::move(composed);
+  plan.composed_mantissa_bits = m;
+  plan.composed_offset_bits = offset_bits;
+  plan.composed_buckets = buckets;
+  plan.ends32 = std::move(ends);
 }
 
 std::optional<DrivePlan> drive_plan(const std::array<const ThresholdIndex*, 3>& channels) {

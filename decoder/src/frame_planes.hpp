@@ -19,10 +19,12 @@ cv::Mat frame_plane(cv::Size size, int type);
 // its own (trm feed's sending thread), and its last reads of the plane must come before a reuse writes it.
 int plane_owners(const cv::Mat& plane);
 
-// At most this many spares are kept per list: beyond it a new plane takes the place of one that a caller still holds
-// (the list forgets it; the caller's copy lives on), or else of the first free one (freed with it), so that a caller
-// who keeps every view does not make the list keep them all after it lets them go.
-inline constexpr std::size_t kMaxSparePlanes = 16;
+// At most this many spares are kept per list: beyond it a new plane takes the place of one held elsewhere (by a caller
+// or by the decoder's own stores: the list forgets it, the holder's copy lives on), or else of the first free one
+// (freed with it), so that a caller who keeps every view does not make the list keep them all after it lets them go.
+// The largest set a decoder itself holds at once is the reference's LCD reduced view with contributed history and
+// report planes: 15 planes (the eye's 8 and the view's 7).
+inline constexpr std::size_t kMaxSparePlanes = 24;
 
 // A plane of `size` and `type` from `spares` that nothing else holds, else a new frame_plane (kept in `spares`).
 // Its samples are those of an earlier view: the caller writes every one.

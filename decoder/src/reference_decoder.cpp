@@ -226,13 +226,20 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   DecodeStages stages;
   RowTallies tallies(full.height);
 
+  // LCD history: v_{t-1} and x_{t-1}. The first frame of an eye has none: the panel is taken to have held this same
+  // frame, x_{t-1} = x_t and v_{t-1} = the held drive of x_t (M(v, v) = x_t^(1/gamma)), quantised as any shown drive.
+  const bool first_lcd_frame = history && eye.previous_drive.empty();
+
   // x_t: what this frame should add to the pair, in linear light, within [0, 1]; then the panel drive of it.
   // Every sample of these planes is written below, so they may be the planes of an earlier view that nothing holds.
-  // Without the report planes, x_t and v_t are rows of scratch (x_t stays a plane where the LCD keeps it as x_{t-1}
-  // or the stages record it) and the emitted light is not computed.
+  // Without the report planes, x_t and v_t are rows of scratch (x_t stays a plane where the stages record it, where
+  // the LCD keeps it as the next x_{t-1}, and on the LCD's first frame, which reads it as x_{t-1}) and the emitted
+  // light is not computed.
   const auto plane = [&eye](int type) { return detail::reusable_plane(eye.spare_planes, eye.full_size, type); };
   const bool planes = config_.report_planes;
-  cv::Mat wanted = planes || history || record ? plane(CV_64FC3) : cv::Mat();
+  const bool wanted_kept =
+      planes || record || (history && (first_lcd_frame || config_.lcd_history == LcdHistory::Wanted));
+  cv::Mat wanted = wanted_kept ? plane(CV_64FC3) : cv::Mat();
   cv::Mat drive = planes ? plane(CV_64FC3) : cv::Mat();
   cv::Mat codes = plane(CV_16UC3);
   cv::Mat emitted = planes ? plane(CV_64FC3) : cv::Mat();
@@ -243,9 +250,6 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     return scratch.data();
   };
 
-  // LCD history: v_{t-1} and x_{t-1}. The first frame of an eye has none: the panel is taken to have held this same
-  // frame, x_{t-1} = x_t and v_{t-1} = the held drive of x_t (M(v, v) = x_t^(1/gamma)), quantised as any shown drive.
-  const bool first_lcd_frame = history && eye.previous_drive.empty();
   cv::Mat previous_drive = first_lcd_frame ? plane(CV_64FC3) : eye.previous_drive;
   const cv::Mat previous_wanted = first_lcd_frame ? wanted : eye.previous_wanted;
   cv::Mat next_drive;   // v_t as shown, the v_{t-1} of the next frame

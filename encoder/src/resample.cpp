@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -246,9 +247,10 @@ cv::Mat downsample(cv::Size full_size, int channels, const FullRow& full_row, in
     const int run_length = run.hi - run.lo;
     std::vector<double> planes(f > 0 ? static_cast<std::size_t>(channels) * full_size.width : 0);
     std::vector<double> sums(static_cast<std::size_t>(run_length));
-    std::vector<double> scratch(static_cast<std::size_t>(channels) * full_size.width);
+    // Not initialised: a row source that uses it fills it.
+    const auto scratch = std::make_unique_for_overwrite<double[]>(static_cast<std::size_t>(channels) * full_size.width);
     for (int y = rows.start; y < rows.end; ++y) {
-      const double* src = full_row(y, scratch.data());
+      const double* src = full_row(y, scratch.get());
       double* dst = horizontal.ptr<double>(y);
       if (f > 0) {
         for (int ch = 0; ch < channels; ++ch) {

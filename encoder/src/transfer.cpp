@@ -205,9 +205,10 @@ cv::Mat quantise_reduced(const cv::Mat& values, int bits) {
   return codes;
 }
 
-DequantisedRows::DequantisedRows(const cv::Mat& codes, int bits) : codes_(codes), max_code_((1 << bits) - 1) {
+DequantisedRows::DequantisedRows(const cv::Mat& codes, int bits) : codes_(codes), max_code_(0) {
   if (codes.depth() != CV_16U) throw std::invalid_argument("dequantise: expected a CV_16U matrix");
   require_bits(bits);
+  max_code_ = (1 << bits) - 1;
   // Every code's value once (the same division), then a lookup per sample; a view with fewer samples than codes
   // (a small one at 16 bits) divides per sample instead.
   const bool by_table = codes.total() * static_cast<std::size_t>(codes.channels()) > static_cast<std::size_t>(max_code_);

@@ -35,28 +35,41 @@ void expect_same_stats(const FrameStats& a, const FrameStats& b, const std::stri
   EXPECT_EQ(a.frame_lost, b.frame_lost) << where;
 }
 
-// A stream with a lost first view (black), full and reduced views, and a lost view in the middle (held).
+// A stream with a lost first view (black), full and reduced views, a full and a reduced view with lost lines
+// (concealed), and a lost view in the middle (held).
 DecodedFrame decode_step(ReferenceDecoder& decoder, const TrmEncoder& encoder, std::int64_t t) {
-  if (t == 0 || t == 5) {
-    FrameMeta meta = encoder.encode(moving_frame(t), t).meta;
-    return decoder.decode_lost(meta);
+  const LinkFrame view = encoder.encode(moving_frame(t), t);
+  if (t == 0 || t == 5) return decoder.decode_lost(view.meta);
+  if (t == 3 || t == 6) {
+    std::vector<std::uint8_t> intact(static_cast<std::size_t>(view.codes.rows), 1);
+    for (std::size_t y = 2; y < 6 && y < intact.size(); ++y) intact[y] = 0;
+    return decoder.decode(view, intact);
   }
-  return decoder.decode(encoder.encode(moving_frame(t), t));
+  return decoder.decode(view);
 }
 
 TEST(ReferenceDecoder, WithoutReportPlanesGivesTheSameCodesAndStatistics) {
-  for (const char* panel : {"vive", "lcd"}) {
+  struct Case {
+    const char* panel;
+    LcdHistory history;
+  };
+  for (const Case& c : {Case{"vive", LcdHistory::Wanted}, Case{"lcd", LcdHistory::Wanted},
+                        Case{"lcd", LcdHistory::Contributed}}) {
+    const char* panel = c.panel;
     for (const bool record : {false, true}) {
       EncoderConfig link;
       DecoderConfig with_planes = test::decoder_config(link, panel);
       with_planes.record_stages = record;
+      with_planes.lcd_history = c.history;
       DecoderConfig codes_only = with_planes;
       codes_only.report_planes = false;
       ReferenceDecoder planes_decoder(with_planes);
       ReferenceDecoder codes_decoder(codes_only);
       const TrmEncoder encoder(link);
       for (std::int64_t t = 0; t < 9; ++t) {
-        const std::string where = std::string(panel) + (record ? ", stages" : "") + ", t = " + std::to_string(t);
+        const std::string where = std::string(panel) +
+                                  (c.history == LcdHistory::Contributed ? ", contributed" : "") +
+                                  (record ? ", stages" : "") + ", t = " + std::to_string(t);
         const DecodedFrame a = decode_step(planes_decoder, encoder, t);
         const DecodedFrame b = decode_step(codes_decoder, encoder, t);
         ASSERT_FALSE(a.wanted_linear.empty()) << where;
@@ -90,26 +103,34 @@ TEST(ReferenceDecoder, FillsAgainOnlyThePlanesNoCallerHolds) {
     DecoderConfig config = test::decoder_config(link, panel);
     config.record_stages = false;
     const TrmEncoder encoder(link);
-    // Every view kept: each keeps the samples it had when it was returned.
+    // Every view kept, with its stage record and a held view (lost at t = 5): each keeps the samples it had when it
+    // was returned.
     {
-      ReferenceDecoder decoder(config);
+      DecoderConfig recording = config;
+      recording.record_stages = true;
+      ReferenceDecoder decoder(recording);
       std::vector<DecodedFrame> kept;
-      std::vector<DecodedFrame> copies;
+      std::vector<std::vector<cv::Mat>> copies;
+      const auto planes_of = [](const DecodedFrame& d) {
+        std::vector<cv::Mat> planes{d.wanted_linear, d.drive, d.drive_codes, d.emitted_linear};
+        if (d.stages) planes.insert(planes.end(), d.stages->planes.begin(), d.stages->planes.end());
+        return planes;
+      };
       for (std::int64_t t = 1; t < 9; ++t) {
-        kept.push_back(decoder.decode(encoder.encode(moving_frame(t), t)));
-        DecodedFrame copy = kept.back();
-        copy.wanted_linear = copy.wanted_linear.clone();
-        copy.drive = copy.drive.clone();
-        copy.drive_codes = copy.drive_codes.clone();
-        copy.emitted_linear = copy.emitted_linear.clone();
+        const LinkFrame view = encoder.encode(moving_frame(t), t);
+        kept.push_back(t == 5 ? decoder.decode_lost(view.meta) : decoder.decode(view));
+        std::vector<cv::Mat> copy;
+        for (const cv::Mat& m : planes_of(kept.back())) copy.push_back(m.clone());
         copies.push_back(copy);
       }
       for (std::size_t i = 0; i < kept.size(); ++i) {
-        const std::string where = std::string(panel) + ", view " + std::to_string(i);
-        EXPECT_EQ(cv::norm(kept[i].wanted_linear, copies[i].wanted_linear, cv::NORM_INF), 0.0) << where;
-        EXPECT_EQ(cv::norm(kept[i].drive, copies[i].drive, cv::NORM_INF), 0.0) << where;
-        EXPECT_EQ(cv::norm(kept[i].drive_codes, copies[i].drive_codes, cv::NORM_INF), 0.0) << where;
-        EXPECT_EQ(cv::norm(kept[i].emitted_linear, copies[i].emitted_linear, cv::NORM_INF), 0.0) << where;
+        const std::vector<cv::Mat> now = planes_of(kept[i]);
+        ASSERT_EQ(now.size(), copies[i].size());
+        for (std::size_t p = 0; p < now.size(); ++p) {
+          if (now[p].empty()) continue;
+          EXPECT_EQ(cv::norm(now[p], copies[i][p], cv::NORM_INF), 0.0)
+              << panel << ", view " << i << ", plane " << p;
+        }
       }
     }
     // No view kept: after the first views, every output lands in memory an earlier view used (no new planes), and

@@ -132,6 +132,34 @@ TEST(Quantise, EveryCodeSurvivesDequantiseQuantise) {
 
 // Through its table (more samples than codes) and by division (fewer), every value is code / (2^bits - 1) exactly,
 // and a code out of range is named in the refusal.
+// A row at a time (DequantisedRows, as reduce_codes reads D's input) is the same doubles as the whole plane, and the
+// codes are checked before any row is read.
+TEST(Quantise, DequantisedRowsAreThePlanesRows) {
+  for (const int bits : {8, 10, 16}) {
+    const int top = (1 << bits) - 1;
+    for (const int width : {700, 3}) {  // more samples than codes (the table) and fewer (the division)
+      cv::Mat codes(4, width, CV_16UC3);
+      for (int k = 0; k < static_cast<int>(codes.total()) * 3; ++k) {
+        codes.ptr<std::uint16_t>()[k] = static_cast<std::uint16_t>((k * 7919 + 13) % (top + 1));
+      }
+      const DequantisedRows rows(codes, bits);
+      const cv::Mat plane = dequantise(codes, bits);
+      std::vector<double> row(static_cast<std::size_t>(3 * width));
+      for (int y = 0; y < codes.rows; ++y) {
+        rows.row(y, row.data());
+        EXPECT_EQ(std::memcmp(row.data(), plane.ptr(y), row.size() * sizeof(double)), 0) << bits << " bits, row " << y;
+      }
+    }
+  }
+  cv::Mat bad(2, 5, CV_16UC3, cv::Scalar(3, 3, 3));
+  bad.at<cv::Vec<std::uint16_t, 3>>(1, 4)[2] = 256;
+  EXPECT_THROW(DequantisedRows(bad, 8), std::invalid_argument);
+  EXPECT_NO_THROW(DequantisedRows(bad, 9));
+  EXPECT_THROW(DequantisedRows(bad, 0), std::invalid_argument);
+  EXPECT_THROW(DequantisedRows(bad, 40), std::invalid_argument);
+  EXPECT_THROW(DequantisedRows(cv::Mat(2, 2, CV_8UC3), 8), std::invalid_argument);
+}
+
 TEST(Quantise, DequantiseIsTheDivisionByTableAndDirectly) {
   for (const int bits : {8, 16}) {
     const int top = (1 << bits) - 1;

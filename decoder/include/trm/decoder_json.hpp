@@ -10,7 +10,8 @@
 namespace trm {
 
 // {"encoder": encoder_json, "sensitivity": s (the string "inf" for +inf), "panel": the panel's JSON, "output_bits",
-// "lcd_history": "wanted" | "contributed"}. record_stages is a run-time choice, not configuration: not written.
+// "lcd_history": "wanted" | "contributed"}. record_stages and report_planes are run-time choices, not configuration:
+// not written.
 nlohmann::ordered_json decoder_json(const DecoderConfig& config);
 // {"decoder": decoder_json, "formats": {every fraction-bit and table-size field by its C++ name}, "residual":
 // {"int_bits", "frac_bits", "signed", "quant", "overflow"}, "skip_unneeded"}.
