@@ -1,6 +1,6 @@
 // One whole view of the streaming fixed-point decoder at a headset size (2160x1200, r = 1/2, panorama, drive codes
 // only: what `trm bench` calls `fixed`), full and reduced views timed apart, on 1 and 2 threads (bands of output
-// lines), OLED and LCD. Items are output pixels, so items_per_second reads as pixels per second. Each iteration decodes
+// lines), OLED and LCD; the same for the double reference. Items are output pixels, so items_per_second reads as pixels per second. Each iteration decodes
 // a full view and the reduced view after it; the timed one is the argument's, the other runs with the timer paused
 // (a reduced view needs the full view's stores).
 #include "trm/encoder.hpp"
@@ -52,12 +52,12 @@ FixedDecoderConfig codes_only(const char* panel, std::int64_t threads) {
   return config;
 }
 
-// Args: timed view (0 = full, 1 = reduced), threads, panel (0 = vive OLED, 1 = lcd).
-void BM_DecodeView(benchmark::State& state) {
+// Each iteration decodes a full view and the reduced view after it, one of them timed (Args: timed view, 0 = full,
+// 1 = reduced; threads; panel, 0 = vive OLED, 1 = lcd), after a pair before the timing: the decoder's geometry, stores
+// and output spares exist, as in a long run.
+void time_views(benchmark::State& state, HeadsetDecoder& decoder) {
   const std::vector<LinkFrame>& views = pair_of_views();
-  FixedStreamingDecoder decoder(codes_only(state.range(2) == 0 ? "vive" : "lcd", state.range(1)));
   const bool timed_reduced = state.range(0) != 0;
-  // A pair before the timing: the decoder's geometry, stores and output spares exist, as in a long run.
   benchmark::DoNotOptimize(decoder.decode(views[0]));
   benchmark::DoNotOptimize(decoder.decode(views[1]));
   for (auto _ : state) {
@@ -75,6 +75,11 @@ void BM_DecodeView(benchmark::State& state) {
   state.SetLabel(std::string(timed_reduced ? "reduced" : "full") + " view, " + (state.range(2) == 0 ? "vive" : "lcd") +
                  ", " + std::to_string(state.range(1)) + " thread(s)");
 }
+
+void BM_DecodeView(benchmark::State& state) {
+  FixedStreamingDecoder decoder(codes_only(state.range(2) == 0 ? "vive" : "lcd", state.range(1)));
+  time_views(state, decoder);
+}
 BENCHMARK(BM_DecodeView)
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
@@ -83,28 +88,11 @@ BENCHMARK(BM_DecodeView)
 // The double reference's full and reduced views, as `trm bench` times it (its rows split over OpenCV's threads, drive
 // codes only). Args: timed view (0 = full, 1 = reduced), threads (OpenCV's), panel (0 = vive, 1 = lcd).
 void BM_ReferenceView(benchmark::State& state) {
-  const std::vector<LinkFrame>& views = pair_of_views();
   const int threads_before = cv::getNumThreads();
   cv::setNumThreads(static_cast<int>(state.range(1)));
   ReferenceDecoder decoder(codes_only(state.range(2) == 0 ? "vive" : "lcd", 1).decoder);
-  const bool timed_reduced = state.range(0) != 0;
-  benchmark::DoNotOptimize(decoder.decode(views[0]));
-  benchmark::DoNotOptimize(decoder.decode(views[1]));
-  for (auto _ : state) {
-    if (timed_reduced) state.PauseTiming();
-    benchmark::DoNotOptimize(decoder.decode(views[0]));
-    if (timed_reduced) {
-      state.ResumeTiming();
-    } else {
-      state.PauseTiming();
-    }
-    benchmark::DoNotOptimize(decoder.decode(views[1]));
-    if (!timed_reduced) state.ResumeTiming();
-  }
+  time_views(state, decoder);
   cv::setNumThreads(threads_before);
-  state.SetItemsProcessed(state.iterations() * kWidth * kHeight);
-  state.SetLabel(std::string(timed_reduced ? "reduced" : "full") + " view, " + (state.range(2) == 0 ? "vive" : "lcd") +
-                 ", " + std::to_string(state.range(1)) + " thread(s)");
 }
 BENCHMARK(BM_ReferenceView)
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})

@@ -7,6 +7,7 @@
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
 
+#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
 #include <cmath>
@@ -107,5 +108,21 @@ inline std::string error_of(const std::function<void()>& action) {
 inline double max_abs_difference(const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_INF); }
 
 inline bool all_finite(const cv::Mat& m) { return cv::checkRange(m, true, nullptr, -1e300, 1e300); }
+
+// The same statistics of one view from two decoders or two settings, bit for bit (a mean motion weight NaN on both
+// sides, not measured, counts as the same).
+inline void expect_same_stats(const FrameStats& a, const FrameStats& b, const std::string& where) {
+  EXPECT_EQ(a.clipped_fraction, b.clipped_fraction) << where;
+  EXPECT_EQ(a.residual_mean_abs, b.residual_mean_abs) << where;
+  EXPECT_EQ(a.residual_max_abs, b.residual_max_abs) << where;
+  EXPECT_EQ(a.dropped_sum, b.dropped_sum) << where;
+  if (!std::isnan(a.mean_motion_weight) || !std::isnan(b.mean_motion_weight)) {
+    EXPECT_EQ(a.mean_motion_weight, b.mean_motion_weight) << where;
+  }
+  EXPECT_EQ(a.residual_applied, b.residual_applied) << where;
+  EXPECT_EQ(a.lcd_unreachable_fraction, b.lcd_unreachable_fraction) << where;
+  EXPECT_EQ(a.concealed_lines, b.concealed_lines) << where;
+  EXPECT_EQ(a.frame_lost, b.frame_lost) << where;
+}
 
 }  // namespace trm::test

@@ -115,17 +115,7 @@ inline void expect_identical_outputs(const DecodedFrame& a, const FixedStageCoun
   ASSERT_TRUE(identical(a.wanted_linear, b.wanted_linear)) << where;
   ASSERT_TRUE(identical(a.drive, b.drive)) << where;
   ASSERT_TRUE(identical(a.emitted_linear, b.emitted_linear)) << where;
-  EXPECT_EQ(a.stats.clipped_fraction, b.stats.clipped_fraction) << where;
-  EXPECT_EQ(a.stats.residual_mean_abs, b.stats.residual_mean_abs) << where;
-  EXPECT_EQ(a.stats.residual_max_abs, b.stats.residual_max_abs) << where;
-  EXPECT_EQ(a.stats.dropped_sum, b.stats.dropped_sum) << where;
-  if (!std::isnan(a.stats.mean_motion_weight) || !std::isnan(b.stats.mean_motion_weight)) {  // NaN: not measured
-    EXPECT_EQ(a.stats.mean_motion_weight, b.stats.mean_motion_weight) << where;
-  }
-  EXPECT_EQ(a.stats.residual_applied, b.stats.residual_applied) << where;
-  EXPECT_EQ(a.stats.lcd_unreachable_fraction, b.stats.lcd_unreachable_fraction) << where;
-  EXPECT_EQ(a.stats.concealed_lines, b.stats.concealed_lines) << where;
-  EXPECT_EQ(a.stats.frame_lost, b.stats.frame_lost) << where;
+  expect_same_stats(a.stats, b.stats, where);
   EXPECT_EQ(counts_a.beta_clipped, counts_b.beta_clipped) << where;
   EXPECT_EQ(counts_a.residual_saturated, counts_b.residual_saturated) << where;
   EXPECT_EQ(counts_a.residual_rounded, counts_b.residual_rounded) << where;

@@ -24,17 +24,6 @@ cv::Mat moving_frame(std::int64_t t) {
   return frame;
 }
 
-void expect_same_stats(const FrameStats& a, const FrameStats& b, const std::string& where) {
-  EXPECT_EQ(a.clipped_fraction, b.clipped_fraction) << where;
-  EXPECT_EQ(a.residual_mean_abs, b.residual_mean_abs) << where;
-  EXPECT_EQ(a.residual_max_abs, b.residual_max_abs) << where;
-  EXPECT_EQ(a.dropped_sum, b.dropped_sum) << where;
-  EXPECT_EQ(a.mean_motion_weight, b.mean_motion_weight) << where;
-  EXPECT_EQ(a.residual_applied, b.residual_applied) << where;
-  EXPECT_EQ(a.lcd_unreachable_fraction, b.lcd_unreachable_fraction) << where;
-  EXPECT_EQ(a.frame_lost, b.frame_lost) << where;
-}
-
 // A stream with a lost first view (black), full and reduced views, a full and a reduced view with lost lines
 // (concealed), and a lost view in the middle (held).
 DecodedFrame decode_step(ReferenceDecoder& decoder, const TrmEncoder& encoder, std::int64_t t) {
@@ -80,7 +69,7 @@ TEST(ReferenceDecoder, WithoutReportPlanesGivesTheSameCodesAndStatistics) {
         EXPECT_TRUE(b.emitted_linear.empty()) << where;
         ASSERT_EQ(b.drive_codes.size(), a.drive_codes.size()) << where;
         EXPECT_EQ(cv::norm(a.drive_codes, b.drive_codes, cv::NORM_INF), 0.0) << where;
-        expect_same_stats(a.stats, b.stats, where);
+        test::expect_same_stats(a.stats, b.stats, where);
         ASSERT_EQ(a.stages.has_value(), b.stages.has_value()) << where;
         if (a.stages) {
           for (std::size_t s = 0; s < a.stages->planes.size(); ++s) {
