@@ -14,6 +14,7 @@
 
 #include "trm/resample.hpp"
 #include "trm/transfer.hpp"
+#include "trm/vector_pow.hpp"
 
 #include <opencv2/core/utility.hpp>
 
@@ -413,6 +414,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
     const double s = config_.sensitivity;
     cv::parallel_for_(cv::Range(0, full.height), [&](const cv::Range& rows) {
       std::vector<double> alpha_buffer(record ? 0 : static_cast<std::size_t>(row_len));
+      std::vector<double> contrast_row;
       std::vector<double> wanted_scratch;
       std::vector<double> drive_scratch;
       for (int y = rows.start; y < rows.end; ++y) {
@@ -432,6 +434,8 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
         double* w_row = weight.ptr<double>(y);
         std::vector<double>& dropped = tallies.dropped[static_cast<std::size_t>(y)];
         std::size_t clipped = 0;
+        // Eq. 5 per pixel, then Eq. 6's exp over the row a vector at a time (exp_elements: std::exp's doubles).
+        contrast_row.resize(static_cast<std::size_t>(full.width));
         for (int x = 0; x < full.width; ++x) {
           const double* p = p_row + 3 * x;
           const double* a = a_row + 3 * x;
@@ -439,9 +443,16 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
           const double y_alpha = kLumaR * a[0] + kLumaG * a[1] + kLumaB * a[2];
           const double sum = y_prev + y_alpha;
           const double c = sum > 0.0 ? std::abs(y_prev - y_alpha) / sum : 0.0;  // Eq. 5
-          const double w = c == 0.0 ? 1.0 : std::exp(-s * c);                   // Eq. 6
-          w_row[x] = w;
+          contrast_row[static_cast<std::size_t>(x)] = c;
+          w_row[x] = -s * c;
           if (record) contrast.ptr<double>(y)[x] = c;
+        }
+        const auto pixels = static_cast<std::size_t>(full.width);
+        exp_elements(std::span<const double>(w_row, pixels), std::span<double>(w_row, pixels));
+        for (int x = 0; x < full.width; ++x) {
+          // Eq. 6; exactly 1 where c = 0 (for s = inf, -s c is NaN there).
+          const double w = contrast_row[static_cast<std::size_t>(x)] == 0.0 ? 1.0 : w_row[x];
+          w_row[x] = w;
           for (int ch = 0; ch < 3; ++ch) {
             const int k = 3 * x + ch;
             const double added = a_row[k] + w * r_row[k];  // Eq. 4

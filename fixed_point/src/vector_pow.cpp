@@ -1,4 +1,4 @@
-// pow_elements (trm/vector_pow.hpp): glibc's pow a vector at a time, compiled once per x86 instruction set by
+// pow_elements and exp_elements (trm/vector_pow.hpp): glibc's pow and exp a vector at a time, compiled once per x86 instruction set by
 // Highway's foreach_target and chosen at run time. The order of operations and the fused multiply-adds follow the
 // FMA build of glibc 2.36's pow (__ieee754_pow_fma, its disassembly read operation by operation): a fusion more or
 // less than glibc's changes the last bit of about one result in three. Hence this file compiles with
@@ -114,6 +114,37 @@ HWY_INLINE void LookupExp(DI di, hn::Vec<DI> slot, hn::Vec<DI>& tail, hn::Vec<DI
   }
 }
 
+// exp(ehi + elo) as glibc's exp_inline (pow's last step) computes it, or exp(ehi) as its exp (__exp_fma, the same
+// operations without elo; elo null): 2^(k/128) exp(r), r = ehi - k ln2/128 (+ elo), from the same table and
+// polynomial. Lanes on its special paths, |ehi| < 2^-54 (the result rounds to 1 +- ulp) or >= 512 (over- and
+// underflow, and inf and NaN), are marked in `special` and must be recomputed by libm.
+template <class D>
+HWY_INLINE hn::Vec<D> ExpVector(D d, hn::Vec<D> ehi, const hn::Vec<D>* elo,
+                                hn::Mask<hn::RebindToSigned<D>>& special) {
+  const hn::RebindToSigned<D> di;
+  const hn::RebindToUnsigned<D> du;
+  using VD = hn::Vec<D>;
+  using VI = hn::Vec<decltype(di)>;
+  const VI abstop = hn::BitCast(di, hn::And(hn::ShiftRight<52>(hn::BitCast(du, ehi)), hn::Set(du, 0x7ff)));
+  special = hn::Or(hn::Lt(abstop, hn::Set(di, 0x3c9)), hn::Gt(abstop, hn::Set(di, 0x407)));
+  const VD shifted = hn::MulAdd(ehi, hn::Set(d, kInvLn2N), hn::Set(d, kShift));
+  const VI ki = hn::BitCast(di, shifted);
+  const VD ke = hn::Sub(shifted, hn::Set(d, kShift));
+  const VD r_hi = hn::MulAdd(ke, hn::Set(d, kNegLn2LoN), hn::MulAdd(ke, hn::Set(d, kNegLn2HiN), ehi));
+  const VD re = elo != nullptr ? hn::Add(*elo, r_hi) : r_hi;
+  const VI slot = hn::ShiftLeft<1>(hn::And(ki, hn::Set(di, 127)));
+  VI tail_bits, scale_bits;
+  LookupExp(di, slot, tail_bits, scale_bits);
+  const VD tail = hn::BitCast(d, tail_bits);
+  const VD scale = hn::BitCast(d, hn::Add(scale_bits, hn::ShiftLeft<45>(ki)));
+  const VD c23 = hn::MulAdd(re, hn::Set(d, kExpPoly[1]), hn::Set(d, kExpPoly[0]));
+  const VD tail_r = hn::Add(re, tail);
+  const VD r2 = hn::Mul(re, re);
+  const VD c45 = hn::MulAdd(re, hn::Set(d, kExpPoly[3]), hn::Set(d, kExpPoly[2]));
+  const VD sum = hn::MulAdd(c45, hn::Mul(r2, r2), hn::MulAdd(c23, r2, tail_r));
+  return hn::MulAdd(sum, scale, scale);
+}
+
 // x^y for one vector; lanes on glibc's special paths are marked in `special` and must be recomputed by std::pow.
 template <class D>
 HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::RebindToSigned<D>>& special) {
@@ -168,27 +199,10 @@ HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::Re
   // y log x as ehi + elo.
   const VD ehi = hn::Mul(y, log_hi);
   const VD elo = hn::MulAdd(y, log_lo, hn::MulSub(log_hi, y, ehi));
-  // exp_inline's own special cases: |ehi| < 2^-54 (x^y rounds to 1 +- ulp) or >= 512 (over/underflow).
-  const VI abstop = hn::BitCast(di, hn::And(hn::ShiftRight<52>(hn::BitCast(du, ehi)), hn::Set(du, 0x7ff)));
-  special = hn::Or(special, hn::Or(hn::Lt(abstop, hn::Set(di, 0x3c9)), hn::Gt(abstop, hn::Set(di, 0x407))));
-
-  // exp_inline: exp(ehi + elo) = 2^(k/128) exp(r), r = ehi - k ln2/128 + elo.
-  const VD shifted = hn::MulAdd(ehi, hn::Set(d, kInvLn2N), hn::Set(d, kShift));
-  const VI ki = hn::BitCast(di, shifted);
-  const VD ke = hn::Sub(shifted, hn::Set(d, kShift));
-  const VD r_hi = hn::MulAdd(ke, hn::Set(d, kNegLn2LoN), hn::MulAdd(ke, hn::Set(d, kNegLn2HiN), ehi));
-  const VD re = hn::Add(elo, r_hi);
-  const VI slot = hn::ShiftLeft<1>(hn::And(ki, hn::Set(di, 127)));
-  VI tail_bits, scale_bits;
-  LookupExp(di, slot, tail_bits, scale_bits);
-  const VD tail = hn::BitCast(d, tail_bits);
-  const VD scale = hn::BitCast(d, hn::Add(scale_bits, hn::ShiftLeft<45>(ki)));
-  const VD c23 = hn::MulAdd(re, hn::Set(d, kExpPoly[1]), hn::Set(d, kExpPoly[0]));
-  const VD tail_r = hn::Add(re, tail);
-  const VD r2 = hn::Mul(re, re);
-  const VD c45 = hn::MulAdd(re, hn::Set(d, kExpPoly[3]), hn::Set(d, kExpPoly[2]));
-  const VD sum = hn::MulAdd(c45, hn::Mul(r2, r2), hn::MulAdd(c23, r2, tail_r));
-  return hn::MulAdd(sum, scale, scale);
+  hn::Mask<decltype(di)> exp_special;
+  const VD result = ExpVector(d, ehi, &elo, exp_special);
+  special = hn::Or(special, exp_special);
+  return result;
 }
 
 // One vector of x^y into out.
@@ -273,12 +287,74 @@ void PowElements(const double* x, const double* y, std::size_t y_step, double* o
 }
 
 const char* Path() { return UseKernel() ? hwy::TargetName(HWY_TARGET) : "libm"; }
+
+// One vector of exp(x) into out, special lanes by std::exp.
+template <class D>
+HWY_INLINE void ExpStore(D d, hn::Vec<D> vx, double* out) {
+  const hn::RebindToSigned<D> di;
+  hn::Mask<decltype(di)> special;
+  auto result = ExpVector(d, vx, nullptr, special);
+  if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
+    HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
+    HWY_ALIGN double xs[hn::MaxLanes(d)];
+    HWY_ALIGN double rs[hn::MaxLanes(d)];
+    hn::Store(hn::VecFromMask(di, special), di, marked);
+    hn::Store(vx, d, xs);
+    hn::Store(result, d, rs);
+    for (std::size_t j = 0; j < hn::Lanes(d); ++j) {
+      if (marked[j] != 0) rs[j] = std::exp(xs[j]);
+    }
+    result = hn::Load(d, rs);
+  }
+  hn::StoreU(result, d, out);
+}
+void ExpKernelElements(const double* x, double* out, std::size_t n) {
+  const hn::ScalableTag<double> d;
+  const std::size_t lanes = hn::Lanes(d);
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes) ExpStore(d, hn::LoadU(d, x + k), out + k);
+  if (k == n) return;
+  // The tail as one more vector, its unused lanes 1 (no special path).
+  HWY_ALIGN double xs[hn::MaxLanes(d)];
+  HWY_ALIGN double rs[hn::MaxLanes(d)];
+  for (std::size_t j = 0; j < lanes; ++j) xs[j] = k + j < n ? x[k + j] : 1.0;
+  ExpStore(d, hn::Load(d, xs), rs);
+  for (std::size_t j = 0; k + j < n; ++j) out[k + j] = rs[j];
+}
+// As UseKernel: each target checks its exp against std::exp at its first use, on x across (-40, 40].
+bool UseExpKernel() {
+  static const bool agrees = [] {
+    const std::array<double, kCheckCount> unit = check_inputs();  // (0, 2]
+    std::array<double, kCheckCount> x{};
+    for (std::size_t k = 0; k < kCheckCount; ++k) x[k] = (unit[k] - 1.0) * 40.0;
+    std::array<double, kCheckCount> fast{};
+    ExpKernelElements(x.data(), fast.data(), kCheckCount);
+    for (std::size_t k = 0; k < kCheckCount; ++k) {
+      const double exact = std::exp(x[k]);
+      if (std::memcmp(&fast[k], &exact, sizeof exact) != 0) return false;
+    }
+    return true;
+  }();
+  return agrees;
+}
+void ExpElements(const double* x, double* out, std::size_t n) {
+  if (UseExpKernel()) {
+    ExpKernelElements(x, out, n);
+  } else {
+    for (std::size_t k = 0; k < n; ++k) out[k] = std::exp(x[k]);
+  }
+}
+const char* ExpPath() { return UseExpKernel() ? hwy::TargetName(HWY_TARGET) : "libm"; }
 #else
 // No FMA (glibc's pow takes its other build there), or not x86: libm itself.
 void PowElements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
   libm_elements(x, y, y_step, out, n);
 }
 const char* Path() { return "libm"; }
+void ExpElements(const double* x, double* out, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) out[k] = std::exp(x[k]);
+}
+const char* ExpPath() { return "libm"; }
 #endif
 
 }  // namespace HWY_NAMESPACE
@@ -295,11 +371,15 @@ namespace vector_pow_detail {
 
 HWY_EXPORT(PowElements);
 HWY_EXPORT(Path);
+HWY_EXPORT(ExpElements);
+HWY_EXPORT(ExpPath);
 
 void elements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
   HWY_DYNAMIC_DISPATCH(PowElements)(x, y, y_step, out, n);
 }
 const char* path() { return HWY_DYNAMIC_DISPATCH(Path)(); }
+void exp_elements(const double* x, double* out, std::size_t n) { HWY_DYNAMIC_DISPATCH(ExpElements)(x, out, n); }
+const char* exp_path() { return HWY_DYNAMIC_DISPATCH(ExpPath)(); }
 
 }  // namespace vector_pow_detail
 
@@ -316,6 +396,11 @@ void pow_elements(std::span<const double> x, std::span<const double> y, std::spa
 }
 
 const char* pow_elements_path() { return vector_pow_detail::path(); }
+void exp_elements(std::span<const double> x, std::span<double> out) {
+  if (x.size() != out.size()) throw std::invalid_argument("exp_elements: x and out differ in size");
+  vector_pow_detail::exp_elements(x.data(), out.data(), x.size());
+}
+const char* exp_elements_path() { return vector_pow_detail::exp_path(); }
 
 }  // namespace trm
 #endif

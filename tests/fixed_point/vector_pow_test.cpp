@@ -1,4 +1,4 @@
-// pow_elements against std::pow, bit for bit, on every instruction set this CPU runs.
+// pow_elements against std::pow and exp_elements against std::exp, bit for bit, on every instruction set this CPU runs.
 #include "trm/vector_pow.hpp"
 
 #include <gtest/gtest.h>
@@ -118,6 +118,49 @@ TEST(VectorPow, InPlaceAndSizeChecks) {
   EXPECT_THROW(trm::pow_elements(values, exponents, out), std::invalid_argument);
 }
 
+// exp_elements against std::exp: the motion test's range (-s c, s up to 255, c in (0, 1]), the whole finite range with
+// its over- and underflow ends, arguments near 0 (the special path below 2^-54 and the first ones above it), and the
+// special values; on every instruction set.
+TEST(VectorExp, EveryElementIsStdExpOnEveryTarget) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  for (const std::int64_t target : supported_targets()) {
+    TargetMock mock(target);
+    SCOPED_TRACE(std::string("target ") + hwy::TargetName(target) + ", kernel path " + trm::exp_elements_path());
+    std::mt19937_64 rng(static_cast<std::uint64_t>(target) + 7);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int kind = 0; kind < 4; ++kind) {
+      std::vector<double> x(1021 * 256 + 3);
+      for (double& v : x) {
+        switch (kind) {
+          case 0: v = -255.0 * unit(rng); break;
+          case 1: v = -750.0 + 1465.0 * unit(rng); break;
+          case 2: v = (rng() % 2 == 0 ? 1.0 : -1.0) * std::ldexp(unit(rng), -static_cast<int>(rng() % 64)); break;
+          default: v = -10.0 * unit(rng); break;
+        }
+      }
+      std::vector<double> got(x.size());
+      trm::exp_elements(x, got);
+      long first = -1;
+      for (std::size_t k = 0; k < x.size() && first < 0; ++k) {
+        if (bits_of(got[k]) != bits_of(std::exp(x[k]))) first = static_cast<long>(k);
+      }
+      EXPECT_EQ(first, -1) << "x kind " << kind << ", exp(" << (first >= 0 ? x[static_cast<std::size_t>(first)] : 0.0)
+                           << ")";
+    }
+    std::vector<double> specials{0.0, -0.0, inf, -inf, std::numeric_limits<double>::quiet_NaN(), 0x1p-54, -0x1p-54,
+                                 0x1p-55, 511.9, 512.0, 709.78, 709.79, -708.0, -745.2, -746.0, 1e-300, -1e-300};
+    std::vector<double> got(specials.size());
+    trm::exp_elements(specials, got);
+    for (std::size_t k = 0; k < specials.size(); ++k) {
+      EXPECT_EQ(bits_of(got[k]), bits_of(std::exp(specials[k]))) << "exp(" << specials[k] << ")";
+    }
+    trm::exp_elements(specials, specials);  // in place
+    for (std::size_t k = 0; k < specials.size(); ++k) EXPECT_EQ(bits_of(specials[k]), bits_of(got[k]));
+  }
+  std::vector<double> shorter(2);
+  EXPECT_THROW(trm::exp_elements(std::vector<double>(3, 0.5), shorter), std::invalid_argument);
+}
+
 // On a CPU with FMA and AVX2 (the CI machines) the kernel must be the one in use on every such target the CPU runs
 // (AVX2, and AVX-512 where it has it): each target's first-use check against std::pow passed. Elsewhere std::pow
 // computes every element, which the tests above cover as well.
@@ -128,6 +171,7 @@ TEST(VectorPow, KernelIsInUseWhereTheCpuHasFma) {
     if (target > HWY_AVX2) continue;
     TargetMock mock(target);
     EXPECT_STREQ(trm::pow_elements_path(), hwy::TargetName(target));
+    EXPECT_STREQ(trm::exp_elements_path(), hwy::TargetName(target));
   }
 }
 

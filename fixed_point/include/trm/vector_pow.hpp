@@ -29,4 +29,11 @@ void pow_elements(std::span<const double> x, std::span<const double> y, std::spa
 // "libm" when std::pow computes them all.
 const char* pow_elements_path();
 
+// out[k] = std::exp(x[k]) for every k, bit for bit (out may be x): glibc's exp (__exp_fma) is the same algorithm as the
+// last step of its pow, and runs here as that step without pow's low word, its special lanes (|x| < 2^-54, |x| >= 512,
+// inf and NaN) by std::exp; std::exp computes every element where the pow kernel is not used. The reference decoder's
+// motion weights w = exp(-s c). Throws std::invalid_argument if the sizes differ.
+void exp_elements(std::span<const double> x, std::span<double> out);
+const char* exp_elements_path();
+
 }  // namespace trm
