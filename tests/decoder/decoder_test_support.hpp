@@ -27,6 +27,19 @@ inline cv::Mat random_image(int width, int height, std::uint64_t seed) {
   return image;
 }
 
+// Frame t of random content whose left half moves 3 pixels a frame (wrapping within the half) and whose right half
+// stands still: the residual, the motion test and the clamps all take part.
+inline cv::Mat half_moving_frame(int width, int height, std::uint64_t seed, std::int64_t t) {
+  const cv::Mat source = random_image(width, height, seed);
+  cv::Mat frame = source.clone();
+  const int half = width / 2;
+  const int shift = static_cast<int>(3 * t) % half;
+  for (int y = 0; y < frame.rows; ++y) {
+    for (int x = 0; x < half; ++x) frame.at<cv::Vec3d>(y, x) = source.at<cv::Vec3d>(y, (x + shift) % half);
+  }
+  return frame;
+}
+
 inline cv::Mat flat_image(int width, int height, cv::Vec3d value) {
   return cv::Mat(height, width, CV_64FC3, cv::Scalar(value[0], value[1], value[2]));
 }

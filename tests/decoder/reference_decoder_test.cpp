@@ -12,17 +12,7 @@
 namespace trm {
 namespace {
 
-// Content whose left half moves and right half stands still, so that the residual, the motion test and the clamps
-// all take part.
-cv::Mat moving_frame(std::int64_t t) {
-  const cv::Mat source = test::random_image(96, 40, 20261207);
-  cv::Mat frame = source.clone();
-  const int shift = static_cast<int>(3 * t) % 48;
-  for (int y = 0; y < frame.rows; ++y) {
-    for (int x = 0; x < 48; ++x) frame.at<cv::Vec3d>(y, x) = source.at<cv::Vec3d>(y, (x + shift) % 48);
-  }
-  return frame;
-}
+cv::Mat moving_frame(std::int64_t t) { return test::half_moving_frame(96, 40, 20261207, t); }
 
 // A stream with a lost first view (black), full and reduced views, a full and a reduced view with lost lines
 // (concealed), and a lost view in the middle (held).

@@ -38,17 +38,7 @@ class Digest {
   std::uint64_t value_ = 14695981039346656037ULL;
 };
 
-// Frame t: random content whose left half moves 3 pixels a frame and whose right half stands still, so that the
-// residual, the motion test and the clamps all take part.
-cv::Mat frame_at(std::int64_t t) {
-  const cv::Mat source = test::random_image(160, 48, 20261206);
-  cv::Mat frame = source.clone();
-  const int shift = static_cast<int>(3 * t) % 80;
-  for (int y = 0; y < frame.rows; ++y) {
-    for (int x = 0; x < 80; ++x) frame.at<cv::Vec3d>(y, x) = source.at<cv::Vec3d>(y, (x + shift) % 80);
-  }
-  return frame;
-}
+cv::Mat frame_at(std::int64_t t) { return test::half_moving_frame(160, 48, 20261206, t); }
 
 struct Case {
   const char* name;
