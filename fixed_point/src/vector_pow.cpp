@@ -1,5 +1,5 @@
-// pow_elements and exp_elements (trm/vector_pow.hpp): glibc's pow and exp a vector at a time, compiled once per x86 instruction set by
-// Highway's foreach_target and chosen at run time. The order of operations and the fused multiply-adds follow the
+// pow_elements and exp_elements (trm/vector_pow.hpp): glibc's pow and exp a vector at a time, compiled once per x86
+// instruction set by Highway's foreach_target and chosen at run time. The order of operations and the fused multiply-adds follow the
 // FMA build of glibc 2.36's pow (__ieee754_pow_fma, its disassembly read operation by operation): a fusion more or
 // less than glibc's changes the last bit of about one result in three. Hence this file compiles with
 // -ffp-contract=off (fixed_point/CMakeLists.txt): only hn::MulAdd / hn::MulSub fuse.
@@ -22,6 +22,9 @@ namespace trm::vector_pow_detail {
 
 inline void libm_elements(const double* x, const double* y, std::size_t y_step, double* out, std::size_t n) {
   for (std::size_t k = 0; k < n; ++k) out[k] = std::pow(x[k], y[k * y_step]);
+}
+inline void libm_exp_elements(const double* x, double* out, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) out[k] = std::exp(x[k]);
 }
 
 // What a target's kernel is checked on before its first use: x across (0, 2], half of it pseudo-random (a 64-bit
@@ -205,11 +208,28 @@ HWY_INLINE hn::Vec<D> PowVector(D d, hn::Vec<D> x, hn::Vec<D> y, hn::Mask<hn::Re
   return result;
 }
 
+// `result` with the lanes marked in `special` recomputed one at a time by libm: lane(xs, j) for lane j, with xs the
+// vector x stored (from the vectors, not from the input array: out may be the input).
+template <class D, class Lane>
+HWY_INLINE hn::Vec<D> WithLibmLanes(D d, hn::Mask<hn::RebindToSigned<D>> special, hn::Vec<D> x, hn::Vec<D> result,
+                                    Lane lane) {
+  const hn::RebindToSigned<D> di;
+  HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
+  HWY_ALIGN double xs[hn::MaxLanes(d)];
+  HWY_ALIGN double rs[hn::MaxLanes(d)];
+  hn::Store(hn::VecFromMask(di, special), di, marked);
+  hn::Store(x, d, xs);
+  hn::Store(result, d, rs);
+  for (std::size_t j = 0; j < hn::Lanes(d); ++j) {
+    if (marked[j] != 0) rs[j] = lane(xs, j);
+  }
+  return hn::Load(d, rs);
+}
+
 // One vector of x^y into out.
 template <class D>
 HWY_INLINE void PowStore(D d, hn::Vec<D> vx, hn::Vec<D> vy, double* out) {
   const hn::RebindToSigned<D> di;
-  const std::size_t lanes = hn::Lanes(d);
   hn::Mask<decltype(di)> special;
   auto result = PowVector(d, vx, vy, special);
   if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
@@ -224,19 +244,10 @@ HWY_INLINE void PowStore(D d, hn::Vec<D> vx, hn::Vec<D> vy, double* out) {
     special = hn::AndNot(hn::Or(zero_base, one_base), special);
   }
   if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
-    // From the vectors, not from x: out may be x.
-    HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
-    HWY_ALIGN double xs[hn::MaxLanes(d)];
     HWY_ALIGN double ys[hn::MaxLanes(d)];
-    HWY_ALIGN double rs[hn::MaxLanes(d)];
-    hn::Store(hn::VecFromMask(di, special), di, marked);
-    hn::Store(vx, d, xs);
     hn::Store(vy, d, ys);
-    hn::Store(result, d, rs);
-    for (std::size_t j = 0; j < lanes; ++j) {
-      if (marked[j] != 0) rs[j] = std::pow(xs[j], ys[j]);
-    }
-    result = hn::Load(d, rs);
+    result = WithLibmLanes(d, special, vx, result,
+                           [&ys](const double* xs, std::size_t j) { return std::pow(xs[j], ys[j]); });
   }
   hn::StoreU(result, d, out);
 }
@@ -295,16 +306,7 @@ HWY_INLINE void ExpStore(D d, hn::Vec<D> vx, double* out) {
   hn::Mask<decltype(di)> special;
   auto result = ExpVector(d, vx, nullptr, special);
   if (HWY_UNLIKELY(!hn::AllFalse(di, special))) {
-    HWY_ALIGN std::int64_t marked[hn::MaxLanes(di)];
-    HWY_ALIGN double xs[hn::MaxLanes(d)];
-    HWY_ALIGN double rs[hn::MaxLanes(d)];
-    hn::Store(hn::VecFromMask(di, special), di, marked);
-    hn::Store(vx, d, xs);
-    hn::Store(result, d, rs);
-    for (std::size_t j = 0; j < hn::Lanes(d); ++j) {
-      if (marked[j] != 0) rs[j] = std::exp(xs[j]);
-    }
-    result = hn::Load(d, rs);
+    result = WithLibmLanes(d, special, vx, result, [](const double* xs, std::size_t j) { return std::exp(xs[j]); });
   }
   hn::StoreU(result, d, out);
 }
@@ -328,12 +330,10 @@ bool UseExpKernel() {
     std::array<double, kCheckCount> x{};
     for (std::size_t k = 0; k < kCheckCount; ++k) x[k] = (unit[k] - 1.0) * 40.0;
     std::array<double, kCheckCount> fast{};
+    std::array<double, kCheckCount> exact{};
     ExpKernelElements(x.data(), fast.data(), kCheckCount);
-    for (std::size_t k = 0; k < kCheckCount; ++k) {
-      const double exact = std::exp(x[k]);
-      if (std::memcmp(&fast[k], &exact, sizeof exact) != 0) return false;
-    }
-    return true;
+    libm_exp_elements(x.data(), exact.data(), kCheckCount);
+    return std::memcmp(fast.data(), exact.data(), sizeof fast) == 0;
   }();
   return agrees;
 }
@@ -341,7 +341,7 @@ void ExpElements(const double* x, double* out, std::size_t n) {
   if (UseExpKernel()) {
     ExpKernelElements(x, out, n);
   } else {
-    for (std::size_t k = 0; k < n; ++k) out[k] = std::exp(x[k]);
+    libm_exp_elements(x, out, n);
   }
 }
 const char* ExpPath() { return UseExpKernel() ? hwy::TargetName(HWY_TARGET) : "libm"; }
@@ -351,9 +351,7 @@ void PowElements(const double* x, const double* y, std::size_t y_step, double* o
   libm_elements(x, y, y_step, out, n);
 }
 const char* Path() { return "libm"; }
-void ExpElements(const double* x, double* out, std::size_t n) {
-  for (std::size_t k = 0; k < n; ++k) out[k] = std::exp(x[k]);
-}
+void ExpElements(const double* x, double* out, std::size_t n) { libm_exp_elements(x, out, n); }
 const char* ExpPath() { return "libm"; }
 #endif
 

@@ -204,16 +204,18 @@ View make_view(const py::handle& codes, std::int64_t t, const std::string& parit
   return view;
 }
 
-// The GIL is released while a decoder runs (other Python threads, other decoders, go on); the lock keeps two threads
-// from running one decoder, whose per-eye state is not for concurrent use, at once.
 // A report plane of a decoded view, or None where the decoder was made without them.
-py::object report_plane(const cv::Mat& plane) { return plane.empty() ? py::object(py::none()) : py::object(share_image(plane)); }
+py::object report_plane(const cv::Mat& plane) {
+  return plane.empty() ? py::object(py::none()) : py::object(share_image(plane));
+}
 
 FixedDecoderConfig with_report_planes(FixedDecoderConfig config, bool report_planes) {
   config.decoder.report_planes = report_planes;
   return config;
 }
 
+// The GIL is released while a decoder runs (other Python threads, other decoders, go on); the lock keeps two threads
+// from running one decoder, whose per-eye state is not for concurrent use, at once.
 class Decoder {
  public:
   Decoder(const std::string& name, const py::object& config, bool report_planes)
