@@ -152,7 +152,9 @@ void DecoderConfig::validate() const {
 }
 
 ReferenceDecoder::ReferenceDecoder(DecoderConfig config)
-    : config_((config.validate(), std::move(config))), emission_(config_.panel, config_.output_bits) {}
+    : config_((config.validate(), std::move(config))), emission_(config_.panel, config_.output_bits) {
+  if (!config_.report_planes && !config_.panel.has_history()) oled_codes_.emplace(config_.panel.oled, config_.output_bits);
+}
 
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
   detail::check_lost_view(meta, "ReferenceDecoder");
@@ -280,6 +282,14 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   const auto drive_row = [&](int y, const double* x_row, double* v_row, double* residual_row) {
     std::uint16_t* q_row = codes.ptr<std::uint16_t>(y);
     double* e_row = planes ? emitted.ptr<double>(y) : nullptr;
+    if (!history && oled_codes_) {
+      // OLED without the drive plane: the codes alone, from where each code begins (the same integers as the pow).
+      const auto n = static_cast<std::size_t>(row_len);
+      if (!oled_codes_->codes(std::span<const double>(x_row, n), std::span<std::uint16_t>(q_row, n))) {
+        tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
+      }
+      return;
+    }
     if (!history) {
       // OLED: v = x^(1/gamma_c), the row's pows a vector at a time (the same doubles as panel.drive per sample).
       panel.oled.drive(std::span<const double>(x_row, static_cast<std::size_t>(row_len)),

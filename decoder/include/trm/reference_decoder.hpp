@@ -3,6 +3,7 @@
 #pragma once
 
 #include "trm/decoder.hpp"
+#include "trm/oled_drive_codes.hpp"
 
 #include <cstdint>
 #include <map>
@@ -60,6 +61,7 @@ class ReferenceDecoder : public HeadsetDecoder {
 
   DecoderConfig config_;
   PanelEmission emission_;  // the light of every drive code (after every previous code, with history)
+  std::optional<OledDriveCodes> oled_codes_;  // OLED without report planes: its codes without a pow per sample
   std::map<int, EyeState> eyes_;
 };
 
