@@ -76,10 +76,12 @@ OledDriveCodes::Table OledDriveCodes::build(double exponent) const {
     }
     t.begins[k] = hi;
   }
-  t.by_pow = exponent < kLeastExponent || t.begins[1] <= 2 * kGuardUlps;
+  t.by_pow = exponent < kLeastExponent || t.begins[1] <= 2 * kGuardUlps + 1;
   for (std::size_t k = 2; k <= top && !t.by_pow; ++k) t.by_pow = t.begins[k] - t.begins[k - 1] <= 2 * kGuardUlps;
   if (t.by_pow) return t;
-  t.first_bucket = (t.begins[1] - kGuardUlps) >> bucket_shift_;
+  // Patterns below `lowest` are looked up as `lowest`: code 0, more than the guard below code 1's first value.
+  t.lowest = t.begins[1] - kGuardUlps - 1;
+  t.first_bucket = t.lowest >> bucket_shift_;
   const std::uint64_t last_bucket = kOneBits >> bucket_shift_;
   t.code_at_bucket.resize(static_cast<std::size_t>(last_bucket - t.first_bucket + 1));
   std::size_t k = 0;
@@ -90,44 +92,73 @@ OledDriveCodes::Table OledDriveCodes::build(double exponent) const {
   return t;
 }
 
-// x in (0, 1), not by_pow.
-std::uint16_t OledDriveCodes::look_up(double x, const Table& t) const {
-  const std::uint64_t u = bits_of(x);
-  const std::uint64_t* begins = t.begins.data();
-  if (u < begins[1] - kGuardUlps) return 0;
-  std::size_t k = t.code_at_bucket[static_cast<std::size_t>((u >> bucket_shift_) - t.first_bucket)];
-  while (u >= begins[k + 1]) ++k;
-  if (u - begins[k] < kGuardUlps || begins[k + 1] - u <= kGuardUlps) return exact(x, t);
-  return static_cast<std::uint16_t>(k);
+// A table's fields for the lookup, held in registers over a row.
+struct OledDriveCodes::Lookup {
+  const std::uint64_t* begins;
+  const std::uint16_t* code_at_bucket;
+  std::uint64_t lowest;
+  std::uint64_t first_bucket;
+  int shift;
+};
+
+// The code of x (not NaN), or -1 where x lies within the guard of a code's first value (the pow decides). Without a
+// branch on x's value in the common case: x clamped to [0, 1] (a maximum and a minimum instruction; -0 becomes +0),
+// its pattern raised to `lowest`; the code at its bucket's lower end, plus one where the bucket's next code begins at
+// or below it (the buckets are fine enough that a second step is rare).
+inline int OledDriveCodes::look_up(double x, const Lookup& t) {
+  const double above_zero = x > 0.0 ? x : 0.0;
+  const std::uint64_t u = std::max(bits_of(above_zero < 1.0 ? above_zero : 1.0), t.lowest);
+  std::size_t k = t.code_at_bucket[static_cast<std::size_t>((u >> t.shift) - t.first_bucket)];
+  k += u >= t.begins[k + 1] ? 1 : 0;
+  while (u >= t.begins[k + 1]) [[unlikely]] ++k;
+  if ((u - t.begins[k] < kGuardUlps) | (t.begins[k + 1] - u <= kGuardUlps)) [[unlikely]] {
+    return -1;
+  }
+  return static_cast<int>(k);
+}
+
+OledDriveCodes::Lookup OledDriveCodes::lookup_of(const Table& t) const {
+  return Lookup{t.begins.data(), t.code_at_bucket.data(), t.lowest, t.first_bucket, bucket_shift_};
 }
 
 std::uint16_t OledDriveCodes::code(double x, int channel) const {
   if (channel < 0 || channel > 2) throw std::invalid_argument("OledDriveCodes: channel must be 0, 1 or 2");
   const Table& t = tables_[of_channel_[static_cast<std::size_t>(channel)]];
   if (t.by_pow) return exact(x, t);
-  if (!(x > 0.0)) return 0;
-  if (x >= 1.0) return static_cast<std::uint16_t>(top_);
-  return look_up(x, t);
+  const int k = look_up(x, lookup_of(t));
+  return k >= 0 ? static_cast<std::uint16_t>(k) : exact(x, t);
 }
 
 bool OledDriveCodes::codes(std::span<const double> x, std::span<std::uint16_t> out) const {
   if (x.size() != out.size()) throw std::invalid_argument("OledDriveCodes::codes: x and out differ in size");
   const std::array<const Table*, 3> table{&tables_[of_channel_[0]], &tables_[of_channel_[1]], &tables_[of_channel_[2]]};
-  const auto top = static_cast<std::uint16_t>(top_);
+  if (table[0]->by_pow || table[1]->by_pow || table[2]->by_pow) {
+    bool nan = false;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      nan |= std::isnan(x[i]);
+      out[i] = std::isnan(x[i]) ? std::uint16_t{0} : code(x[i], static_cast<int>(i % 3));
+    }
+    return !nan;
+  }
+  const std::array<Lookup, 3> lookup{lookup_of(*table[0]), lookup_of(*table[1]), lookup_of(*table[2])};
   bool nan = false;
-  std::size_t channel = 0;
-  for (std::size_t i = 0; i < x.size(); ++i, channel = channel == 2 ? 0 : channel + 1) {
+  const auto one = [&](std::size_t i, std::size_t channel) {
     const double v = x[i];
-    const Table& t = *table[channel];
-    if (std::isnan(v)) {
+    if (std::isnan(v)) [[unlikely]] {
       nan = true;
       out[i] = 0;
-    } else if (t.by_pow) {
-      out[i] = exact(v, t);
-    } else {
-      out[i] = !(v > 0.0) ? std::uint16_t{0} : v >= 1.0 ? top : look_up(v, t);
+      return;
     }
+    const int k = look_up(v, lookup[channel]);
+    out[i] = k >= 0 ? static_cast<std::uint16_t>(k) : exact(v, *table[channel]);
+  };
+  std::size_t i = 0;
+  for (; i + 3 <= x.size(); i += 3) {
+    one(i, 0);
+    one(i + 1, 1);
+    one(i + 2, 2);
   }
+  for (; i < x.size(); ++i) one(i, i % 3);
   return !nan;
 }
 

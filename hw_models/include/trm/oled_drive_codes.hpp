@@ -34,13 +34,16 @@ class OledDriveCodes {
   struct Table {
     double exponent = 1.0;  // 1 / gamma, as OledPanel::drive computes it
     std::vector<std::uint64_t> begins;
-    std::uint64_t first_bucket = 0;  // bucket of the lowest pattern looked up (code 1's first less the guard)
+    std::uint64_t lowest = 0;        // the lowest pattern looked up (more than the guard below code 1's first)
+    std::uint64_t first_bucket = 0;  // its bucket
     std::vector<std::uint16_t> code_at_bucket;
     bool by_pow = false;  // the codes' first values were not apart by twice the guard: every code by the pow
   };
+  struct Lookup;
   Table build(double exponent) const;
   std::uint16_t exact(double x, const Table& t) const;
-  std::uint16_t look_up(double x, const Table& t) const;
+  Lookup lookup_of(const Table& t) const;
+  static int look_up(double x, const Lookup& t);
 
   int top_;
   int bucket_shift_;
