@@ -236,8 +236,8 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   // x_t: what this frame should add to the pair, in linear light, within [0, 1]; then the panel drive of it.
   // Every sample of these planes is written below, so they may be the planes of an earlier view that nothing holds.
   // Without the report planes, x_t and v_t are rows of scratch (x_t stays a plane where the stages record it, where
-  // the LCD keeps it as the next x_{t-1}, and on the LCD's first frame, which reads it as x_{t-1}) and the emitted
-  // light is not computed.
+  // the LCD keeps it as the next x_{t-1}, and on the LCD's first frame, which reads it as x_{t-1}; an OLED's v_t is not
+  // computed at all, its codes come from OledDriveCodes) and the emitted light is not computed.
   const auto plane = [&eye](int type) { return detail::reusable_plane(eye.spare_planes, eye.full_size, type); };
   const bool planes = config_.report_planes;
   const bool wanted_kept =
@@ -282,7 +282,7 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
   const auto drive_row = [&](int y, const double* x_row, double* v_row, double* residual_row) {
     std::uint16_t* q_row = codes.ptr<std::uint16_t>(y);
     double* e_row = planes ? emitted.ptr<double>(y) : nullptr;
-    if (!history && oled_codes_) {
+    if (oled_codes_) {
       // OLED without the drive plane: the codes alone, from where each code begins (the same integers as the pow).
       const auto n = static_cast<std::size_t>(row_len);
       if (!oled_codes_->codes(std::span<const double>(x_row, n), std::span<std::uint16_t>(q_row, n))) {

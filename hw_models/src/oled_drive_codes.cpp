@@ -16,14 +16,15 @@ namespace trm {
 // p 2^-52.1 for a normal result. quantise is monotone in P (a clamp, a product by a positive constant and a sum, each
 // correctly rounded). begins[k] = b is a double with code(b) >= k whose predecessor b- has code(b-) < k (a bisection
 // finds one whatever P does elsewhere). A double x at least G ulps above b is above b (1 + G 2^-53), so
-// p(x) >= p(b) (1 + G 2^-53)^e with e >= 1/4 (kMaxPanelGamma = 4); at G = 256 that factor exceeds 1 + 2^-47, far
-// above the (1 + 2^-52.1) / (1 - 2^-52.1) the two errors can take back: P(x) >= P(b) and code(x) >= k. Likewise a
-// double at least G ulps below b- has P(x) <= P(b-) and code(x) < k. So a double at least G ulps from every begins[k]
-// has the code of the number of begins at or below it. The results there are at least (1/2) / (2^16 - 1), normal.
+// p(x) >= p(b) (1 + G 2^-53)^e with e >= 1/4 (gamma <= 4); at G = 256 that factor exceeds 1 + 2^-47, far above the
+// (1 + 2^-52.1) / (1 - 2^-52.1) the two errors can take back: P(x) >= P(b) and code(x) >= k. A double at least G ulps
+// below b- is below b- (1 - G 2^-54) (the ulps halve below a power of two), so p(x) <= p(b-) (1 - 2^-48) and likewise
+// P(x) <= P(b-) and code(x) < k. So a double at least G ulps from every begins[k] has the code of the number of begins
+// at or below it. The results there are at least (1/2) / (2^16 - 1), normal.
 namespace {
 
 constexpr std::uint64_t kOneBits = 0x3FF0000000000000ULL;  // the pattern of 1.0
-constexpr double kLeastExponent = 1.0 / kMaxPanelGamma;    // the proof's e >= 1/4
+static_assert(kMaxPanelGamma <= 4.0, "the guard's proof takes gamma <= 4: widen kGuardUlps for larger gammas");
 
 std::uint64_t bits_of(double x) { return std::bit_cast<std::uint64_t>(x); }
 double from_bits(std::uint64_t u) { return std::bit_cast<double>(u); }
@@ -37,7 +38,8 @@ OledDriveCodes::OledDriveCodes(const OledPanel& panel, int bits) {
   }
   top_ = (1 << bits) - 1;
   // Buckets two bits finer than the codes near 1, where their first values lie closest (relatively gamma / top apart):
-  // a bucket holds the first value of at most about one code.
+  // up to 12 bits a bucket holds the first value of at most about one code (a few at 13-16 bits, where the table's
+  // size stops the refinement and the lookup steps more).
   bucket_shift_ = 52 - std::min(bits + 2, 14);
   for (std::size_t c = 0; c < 3; ++c) {
     const double exponent = 1.0 / panel.gamma[c];
@@ -76,9 +78,14 @@ OledDriveCodes::Table OledDriveCodes::build(double exponent) const {
     }
     t.begins[k] = hi;
   }
-  t.by_pow = exponent < kLeastExponent || t.begins[1] <= 2 * kGuardUlps + 1;
-  for (std::size_t k = 2; k <= top && !t.by_pow; ++k) t.by_pow = t.begins[k] - t.begins[k - 1] <= 2 * kGuardUlps;
-  if (t.by_pow) return t;
+  // The lookup takes the first values in order and more than two guards apart (for gammas in [1/2, 4] and 16 bits at
+  // most they are billions of ulps apart).
+  for (std::size_t k = 1; k <= top; ++k) {
+    if (t.begins[k] <= t.begins[k - 1] + 2 * kGuardUlps + 1) {
+      throw std::logic_error("OledDriveCodes: the first values of codes " + std::to_string(k - 1) + " and " +
+                             std::to_string(k) + " lie within two guards of each other");
+    }
+  }
   // Patterns below `lowest` are looked up as `lowest`: code 0, more than the guard below code 1's first value.
   t.lowest = t.begins[1] - kGuardUlps - 1;
   t.first_bucket = t.lowest >> bucket_shift_;
@@ -93,7 +100,7 @@ OledDriveCodes::Table OledDriveCodes::build(double exponent) const {
 }
 
 // A table's fields for the lookup, held in registers over a row.
-struct OledDriveCodes::Lookup {
+struct OledDriveCodes::LookupFields {
   const std::uint64_t* begins;
   const std::uint16_t* code_at_bucket;
   std::uint64_t lowest;
@@ -105,7 +112,7 @@ struct OledDriveCodes::Lookup {
 // branch on x's value in the common case: x clamped to [0, 1] (a maximum and a minimum instruction; -0 becomes +0),
 // its pattern raised to `lowest`; the code at its bucket's lower end, plus one where the bucket's next code begins at
 // or below it (the buckets are fine enough that a second step is rare).
-inline int OledDriveCodes::look_up(double x, const Lookup& t) {
+inline int OledDriveCodes::look_up(double x, const LookupFields& t) {
   const double above_zero = x > 0.0 ? x : 0.0;
   const std::uint64_t u = std::max(bits_of(above_zero < 1.0 ? above_zero : 1.0), t.lowest);
   std::size_t k = t.code_at_bucket[static_cast<std::size_t>((u >> t.shift) - t.first_bucket)];
@@ -117,30 +124,21 @@ inline int OledDriveCodes::look_up(double x, const Lookup& t) {
   return static_cast<int>(k);
 }
 
-OledDriveCodes::Lookup OledDriveCodes::lookup_of(const Table& t) const {
-  return Lookup{t.begins.data(), t.code_at_bucket.data(), t.lowest, t.first_bucket, bucket_shift_};
+OledDriveCodes::LookupFields OledDriveCodes::fields_of(const Table& t) const {
+  return LookupFields{t.begins.data(), t.code_at_bucket.data(), t.lowest, t.first_bucket, bucket_shift_};
 }
 
 std::uint16_t OledDriveCodes::code(double x, int channel) const {
   if (channel < 0 || channel > 2) throw std::invalid_argument("OledDriveCodes: channel must be 0, 1 or 2");
   const Table& t = tables_[of_channel_[static_cast<std::size_t>(channel)]];
-  if (t.by_pow) return exact(x, t);
-  const int k = look_up(x, lookup_of(t));
+  const int k = look_up(x, fields_of(t));
   return k >= 0 ? static_cast<std::uint16_t>(k) : exact(x, t);
 }
 
 bool OledDriveCodes::codes(std::span<const double> x, std::span<std::uint16_t> out) const {
   if (x.size() != out.size()) throw std::invalid_argument("OledDriveCodes::codes: x and out differ in size");
   const std::array<const Table*, 3> table{&tables_[of_channel_[0]], &tables_[of_channel_[1]], &tables_[of_channel_[2]]};
-  if (table[0]->by_pow || table[1]->by_pow || table[2]->by_pow) {
-    bool nan = false;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      nan |= std::isnan(x[i]);
-      out[i] = std::isnan(x[i]) ? std::uint16_t{0} : code(x[i], static_cast<int>(i % 3));
-    }
-    return !nan;
-  }
-  const std::array<Lookup, 3> lookup{lookup_of(*table[0]), lookup_of(*table[1]), lookup_of(*table[2])};
+  const std::array<LookupFields, 3> fields{fields_of(*table[0]), fields_of(*table[1]), fields_of(*table[2])};
   bool nan = false;
   const auto one = [&](std::size_t i, std::size_t channel) {
     const double v = x[i];
@@ -149,7 +147,7 @@ bool OledDriveCodes::codes(std::span<const double> x, std::span<std::uint16_t> o
       out[i] = 0;
       return;
     }
-    const int k = look_up(v, lookup[channel]);
+    const int k = look_up(v, fields[channel]);
     out[i] = k >= 0 ? static_cast<std::uint16_t>(k) : exact(v, *table[channel]);
   };
   std::size_t i = 0;

@@ -31,13 +31,16 @@ TEST(ReferenceDecoder, WithoutReportPlanesGivesTheSameCodesAndStatistics) {
   struct Case {
     const char* panel;
     LcdHistory history;
+    int bits;  // the link's and the drive codes'
   };
-  for (const Case& c : {Case{"vive", LcdHistory::Wanted}, Case{"lcd", LcdHistory::Wanted},
-                        Case{"lcd", LcdHistory::Contributed}}) {
+  for (const Case& c : {Case{"vive", LcdHistory::Wanted, 8}, Case{"vive", LcdHistory::Wanted, 10},
+                        Case{"lcd", LcdHistory::Wanted, 8}, Case{"lcd", LcdHistory::Contributed, 8}}) {
     const char* panel = c.panel;
     for (const bool record : {false, true}) {
       EncoderConfig link;
+      link.bits = c.bits;
       DecoderConfig with_planes = test::decoder_config(link, panel);
+      with_planes.output_bits = c.bits;
       with_planes.record_stages = record;
       with_planes.lcd_history = c.history;
       DecoderConfig codes_only = with_planes;
@@ -46,7 +49,7 @@ TEST(ReferenceDecoder, WithoutReportPlanesGivesTheSameCodesAndStatistics) {
       ReferenceDecoder codes_decoder(codes_only);
       const TrmEncoder encoder(link);
       for (std::int64_t t = 0; t < 9; ++t) {
-        const std::string where = std::string(panel) +
+        const std::string where = std::string(panel) + ", " + std::to_string(c.bits) + " bits" +
                                   (c.history == LcdHistory::Contributed ? ", contributed" : "") +
                                   (record ? ", stages" : "") + ", t = " + std::to_string(t);
         const DecodedFrame a = decode_step(planes_decoder, encoder, t);

@@ -25,29 +25,35 @@ OledPanel oled_with(std::array<double, 3> gamma) {
   return panel;
 }
 
-std::uint16_t by_pow(const OledPanel& panel, double x, int channel, int bits) {
+std::uint16_t code_by_pow(const OledPanel& panel, double x, int channel, int bits) {
   return quantise(panel.drive(x, channel), (1 << bits) - 1);
 }
 
 // Every double from `span` ulps below to `span` ulps above each code's exact crossing ((k - 1/2) / top)^gamma, every
-// `code_step`-th code, on each channel.
+// `code_step`-th code, on each channel: one at a time (code) and as a row with the value at its channel's places
+// (codes, what the decoders call).
 void expect_exact_around_crossings(const OledPanel& panel, int bits, std::int64_t span, int code_step) {
   const OledDriveCodes codes(panel, bits);
   const int top = (1 << bits) - 1;
-  std::size_t checked = 0;
   for (int channel = 0; channel < 3; ++channel) {
     const double gamma = panel.gamma[static_cast<std::size_t>(channel)];
+    std::vector<double> row;
     for (int k = 1; k <= top; k += code_step) {
       const auto centre = std::bit_cast<std::int64_t>(std::pow((k - 0.5) / top, gamma));
       for (std::int64_t d = -span; d <= span; ++d) {
         const double x = std::bit_cast<double>(centre + d);
-        ASSERT_EQ(codes.code(x, channel), by_pow(panel, x, channel, bits))
+        ASSERT_EQ(codes.code(x, channel), code_by_pow(panel, x, channel, bits))
             << "bits " << bits << " gamma " << gamma << " code " << k << " x " << x << " (" << d << " ulps)";
-        ++checked;
+        for (int c = 0; c < 3; ++c) row.push_back(c == channel ? x : 0.5);
       }
     }
+    std::vector<std::uint16_t> out(row.size());
+    ASSERT_TRUE(codes.codes(row, out));
+    for (std::size_t i = static_cast<std::size_t>(channel); i < row.size(); i += 3) {
+      ASSERT_EQ(out[i], code_by_pow(panel, row[i], channel, bits)) << "bits " << bits << " gamma " << gamma << " x " << row[i];
+    }
+    EXPECT_GT(row.size(), std::size_t{0});
   }
-  EXPECT_GT(checked, std::size_t{0});
 }
 
 const std::array<std::array<double, 3>, 3> kGammas{{{2.2, 2.2, 2.2}, {kMinPanelGamma, 1.0, kMaxPanelGamma}, {1.8, 2.2, 2.6}}};
@@ -79,7 +85,7 @@ TEST(OledDriveCodes, RandomAndSpecialValuesHaveThePowsCode) {
       ASSERT_TRUE(codes.codes(x, row));
       for (std::size_t i = 0; i < x.size(); ++i) {
         const int channel = static_cast<int>(i % 3);
-        ASSERT_EQ(row[i], by_pow(panel, x[i], channel, bits)) << "bits " << bits << " x " << x[i] << " channel " << channel;
+        ASSERT_EQ(row[i], code_by_pow(panel, x[i], channel, bits)) << "bits " << bits << " x " << x[i] << " channel " << channel;
         ASSERT_EQ(codes.code(x[i], channel), row[i]);
       }
     }
@@ -92,7 +98,7 @@ TEST(OledDriveCodes, NanGivesCodeZeroAndIsReported) {
   std::vector<std::uint16_t> out(3, 7);
   EXPECT_FALSE(codes.codes(x, out));
   EXPECT_EQ(out[1], 0);
-  EXPECT_EQ(out[0], by_pow(oled_with({2.2, 2.2, 2.2}), 0.25, 0, 8));
+  EXPECT_EQ(out[0], code_by_pow(oled_with({2.2, 2.2, 2.2}), 0.25, 0, 8));
   EXPECT_EQ(out[2], 255);
   const std::vector<double> clean{0.25, 0.5, 1.0};
   EXPECT_TRUE(codes.codes(clean, out));

@@ -37,13 +37,12 @@ class OledDriveCodes {
     std::uint64_t lowest = 0;        // the lowest pattern looked up (more than the guard below code 1's first)
     std::uint64_t first_bucket = 0;  // its bucket
     std::vector<std::uint16_t> code_at_bucket;
-    bool by_pow = false;  // the codes' first values were not apart by twice the guard: every code by the pow
   };
-  struct Lookup;
+  struct LookupFields;
   Table build(double exponent) const;
   std::uint16_t exact(double x, const Table& t) const;
-  Lookup lookup_of(const Table& t) const;
-  static int look_up(double x, const Lookup& t);
+  LookupFields fields_of(const Table& t) const;
+  static int look_up(double x, const LookupFields& t);
 
   int top_;
   int bucket_shift_;
