@@ -1,5 +1,6 @@
 // The display methods (decoder/src/methods): the registry, and the baselines of the paper's Table 1 against their
 // analytic answers (pixels per pair, mean light over a pair, repeated frames, NCSFI's pair average).
+#include "decoder_test_support.hpp"
 #include "trm/display_method.hpp"
 #include "trm/reference_decoder.hpp"
 #include "trm/scene.hpp"
@@ -7,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -296,6 +298,51 @@ TEST(DisplayMethods, LostViewsHoldAndLostLinesAreConcealedInEveryMethod) {
     const DecodedFrame lost = display->show_lost(sender->view_meta(t, 0, cv::Size(24, 16)));
     EXPECT_TRUE(lost.stats.frame_lost) << m.name;
     EXPECT_EQ(cv::norm(lost.drive_codes, concealed.drive_codes, cv::NORM_INF), 0.0) << m.name;
+  }
+}
+
+// DecoderConfig::report_planes = false is one setting for every method: the same codes and statistics in every slot
+// (sent, unsent, lost, on both panels, with the TRM methods on both decoders), and no report plane.
+TEST(DisplayMethods, WithoutReportPlanesEveryMethodShowsTheSameCodesAndStatistics) {
+  const cv::Size size(24, 16);
+  SceneParams params;
+  params.width = size.width;
+  params.height = size.height;
+  const auto scene = make_scene("discs", params);
+  for (const DisplayMethod& m : display_methods()) {
+    for (const std::string panel : {"vive", "lcd"}) {
+      for (const std::string impl : {"reference", "fixed"}) {
+        if (impl == "fixed" && !m.fixed_point) continue;  // a plain-frame method has no fixed-point decoder
+        std::array<std::vector<DecodedFrame>, 2> shown;  // [0]: with the planes, [1]: without
+        for (const bool planes : {true, false}) {
+          MethodSetup setup;
+          setup.decoder.decoder.panel = parse_panel(panel);
+          setup.decoder.decoder.report_planes = planes;
+          setup.impl = impl;
+          const auto sender = m.make_sender(setup);
+          const auto display = m.make_display(setup);
+          for (int t = 0; t < 7; ++t) {
+            if (!sender->sends(t, 0)) {
+              shown[planes ? 0 : 1].push_back(display->show_unsent(unsent_slot(t, 0, size, setup.decoder.decoder.link)));
+            } else if (t == 4) {
+              shown[planes ? 0 : 1].push_back(display->show_lost(sender->view_meta(t, 0, size)));
+            } else {
+              shown[planes ? 0 : 1].push_back(display->show(sender->send(scene->linear_frame(t), t, 0).frame, {}));
+            }
+          }
+        }
+        for (std::size_t t = 0; t < shown[0].size(); ++t) {
+          const std::string where = m.name + " " + panel + " " + impl + " t=" + std::to_string(t);
+          const DecodedFrame& with = shown[0][t];
+          const DecodedFrame& without = shown[1][t];
+          ASSERT_FALSE(with.drive_codes.empty()) << where;
+          EXPECT_EQ(cv::norm(with.drive_codes, without.drive_codes, cv::NORM_INF), 0.0) << where;
+          test::expect_same_stats(with.stats, without.stats, where);
+          EXPECT_FALSE(with.emitted_linear.empty()) << where;
+          EXPECT_TRUE(without.wanted_linear.empty() && without.drive.empty() && without.emitted_linear.empty()) << where;
+        }
+      }
+    }
   }
 }
 

@@ -40,8 +40,9 @@ struct DecoderConfig {
   // The report planes of DecodedFrame (wanted_linear, drive, emitted_linear: three full-size CV_64FC3 planes, 3 x
   // 59 MiB at 2160x1200) besides the drive codes, the hardware's output. false leaves them empty: what a testbench,
   // a rig feed, a comparison of codes or a throughput run needs; the fixed-point LCD's report drive value (a division
-  // per sample) and the reference's emitted light are then not computed. Like record_stages, a run-time choice: the
-  // codes and statistics are the same either way.
+  // per sample) and the reference's emitted light are then not computed, and the display methods that show plain
+  // frames return their codes alone. Like record_stages, a run-time choice: the codes and statistics are the same
+  // either way.
   bool report_planes = true;
 
   void validate() const;       // throws std::invalid_argument with a clear message

@@ -5,15 +5,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
 namespace trm::methods {
 
 PanelShow::PanelShow(const DecoderConfig& config)
-    : config_(config), emission_((config_.validate(), config_.panel), config_.output_bits) {}
+    : config_(config), emission_((config_.validate(), config_.panel), config_.output_bits) {
+  if (!config_.report_planes && !config_.panel.has_history()) oled_codes_.emplace(config_.panel.oled, config_.output_bits);
+}
+
+// The drive codes alone (DecoderConfig::report_planes = false): the same integers as quantise() of the drive plane.
+cv::Mat PanelShow::codes_of(const cv::Mat& wanted) const {
+  cv::Mat codes(wanted.size(), CV_16UC3);
+  const auto n = static_cast<std::size_t>(3 * wanted.cols);
+  const int top = (1 << config_.output_bits) - 1;
+  for (int y = 0; y < wanted.rows; ++y) {
+    const double* x_row = wanted.ptr<double>(y);
+    std::uint16_t* q_row = codes.ptr<std::uint16_t>(y);
+    if (oled_codes_) {
+      if (!oled_codes_->codes(std::span<const double>(x_row, n), std::span<std::uint16_t>(q_row, n))) {
+        throw std::invalid_argument("quantise: NaN value");
+      }
+      continue;
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      const double v = config_.panel.drive_from_linear(x_row[k], static_cast<int>(k % 3));
+      if (std::isnan(v)) throw std::invalid_argument("quantise: NaN value");
+      q_row[k] = quantise(v, top);
+    }
+  }
+  return codes;
+}
 
 DecodedFrame PanelShow::show(const FrameMeta& meta, const cv::Mat& wanted) {
+  if (!config_.report_planes) return emit(meta, cv::Mat(), cv::Mat(), codes_of(wanted));
   cv::Mat drive(wanted.size(), CV_64FC3);
   for (int y = 0; y < wanted.rows; ++y) {
     const auto* x_row = wanted.ptr<cv::Vec3d>(y);
@@ -51,7 +78,8 @@ DecodedFrame PanelShow::hold(const FrameMeta& meta) {
 
 DecodedFrame PanelShow::black(const FrameMeta& meta) {
   const cv::Size full(meta.full_width, meta.full_height);
-  return emit(meta, cv::Mat::zeros(full, CV_64FC3), cv::Mat::zeros(full, CV_64FC3), cv::Mat::zeros(full, CV_16UC3));
+  const auto zero_plane = [&] { return config_.report_planes ? cv::Mat::zeros(full, CV_64FC3) : cv::Mat(); };
+  return emit(meta, zero_plane(), zero_plane(), cv::Mat::zeros(full, CV_16UC3));
 }
 
 DecodedFrame PanelShow::lost(const FrameMeta& meta) {
@@ -74,8 +102,8 @@ DecodedFrame PanelShow::emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat driv
   const auto last = last_.find(meta.eye);
   const bool have_previous = last != last_.end() && last->second.drive_codes.size() == out.drive_codes.size();
   const cv::Mat& previous = have_previous ? last->second.drive_codes : out.drive_codes;
-  out.emitted_linear.create(out.drive_codes.size(), CV_64FC3);
-  for (int y = 0; y < out.drive_codes.rows; ++y) {
+  if (config_.report_planes) out.emitted_linear.create(out.drive_codes.size(), CV_64FC3);
+  for (int y = 0; y < out.emitted_linear.rows; ++y) {
     const auto* q_row = out.drive_codes.ptr<cv::Vec3w>(y);
     const auto* p_row = previous.ptr<cv::Vec3w>(y);
     auto* e_row = out.emitted_linear.ptr<cv::Vec3d>(y);

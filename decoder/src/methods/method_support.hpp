@@ -2,15 +2,19 @@
 // panel with no temporal compensation. The drive is the panel's held inverse (OLED v = x^(1/gamma_c); LCD the v with
 // M(v, v)^gamma = x), quantised to the output depth; the light is the panel's forward model of the codes shown,
 // which on an LCD merges each frame with the one before (Eq. 7), as an uncompensated panel does. TRM's own inverse
-// (and its LCD pair compensation) lives in the decoders.
+// (and its LCD pair compensation) lives in the decoders. With DecoderConfig::report_planes = false it returns the
+// drive codes alone, as the TRM decoders do (no wanted, drive or emitted planes; an OLED's codes without a pow per
+// sample, OledDriveCodes), the same codes and statistics.
 #pragma once
 
 #include "trm/decoder.hpp"
 #include "trm/display_method.hpp"
 #include "trm/encoder.hpp"
+#include "trm/oled_drive_codes.hpp"
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <span>
 
 namespace trm::methods {
@@ -33,8 +37,10 @@ class PanelShow {
 
  private:
   DecodedFrame emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat drive, cv::Mat codes);
+  cv::Mat codes_of(const cv::Mat& wanted) const;
   DecoderConfig config_;
   PanelEmission emission_;
+  std::optional<OledDriveCodes> oled_codes_;  // an OLED without report planes: its codes without a pow per sample
   std::map<int, DecodedFrame> last_;  // per eye
 };
 
