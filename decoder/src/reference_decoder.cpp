@@ -154,6 +154,11 @@ void DecoderConfig::validate() const {
 ReferenceDecoder::ReferenceDecoder(DecoderConfig config)
     : config_((config.validate(), std::move(config))), emission_(config_.panel, config_.output_bits) {
   if (!config_.report_planes && !config_.panel.has_history()) oled_codes_.emplace(config_.panel.oled, config_.output_bits);
+  const int top = max_code(config_.output_bits);
+  drive_value_of_code_.resize(static_cast<std::size_t>(top) + 1);
+  for (int code = 0; code <= top; ++code) {
+    drive_value_of_code_[static_cast<std::size_t>(code)] = dequantise(static_cast<std::uint16_t>(code), top);
+  }
 }
 
 DecodedFrame ReferenceDecoder::decode_lost(const FrameMeta& meta) {
@@ -314,33 +319,36 @@ DecodedFrame ReferenceDecoder::decode_view(const LinkFrame& frame, std::span<con
         vp_row[k] = dequantise(quantise(panel.drive_from_linear(x_row[k], k % 3), top), top);
       }
     }
-    // The LCD drive of the row a chunk at a time (the same doubles as panel.drive per sample).
+    // The LCD drive of the row a chunk at a time (the same doubles as panel.drive per sample); the shown drive v_t as
+    // the next frame's v_{t-1} by each code's value (dequantise's doubles, without a division per sample).
     constexpr int kChunk = 255;
     std::array<PanelDriveSample, kChunk> samples;
     double* next_row = next_drive.ptr<double>(y);
     double* target_row = record ? lcd_target.ptr<double>(y) : nullptr;
     double* contributed_row = contributed.empty() ? nullptr : contributed.ptr<double>(y);
     std::uint8_t* unreachable_row = record ? lcd_unreachable.ptr<std::uint8_t>(y) : nullptr;
+    const double* value_of_code = drive_value_of_code_.data();
     bool nan = false;
     std::size_t unreachable = 0;
-    for (int k = 0; k < row_len; ++k) {
-      const double x_t = x_row[k];
-      if (k % kChunk == 0) {
-        const auto count = static_cast<std::size_t>(std::min(kChunk, row_len - k));
-        panel.lcd.drive(std::span<const double>(x_row + k, count), std::span<const double>(xp_row + k, count),
-                        std::span<const double>(vp_row + k, count), std::span<PanelDriveSample>(samples.data(), count));
+    for (int start = 0; start < row_len; start += kChunk) {
+      const auto count = static_cast<std::size_t>(std::min(kChunk, row_len - start));
+      panel.lcd.drive(std::span<const double>(x_row + start, count), std::span<const double>(xp_row + start, count),
+                      std::span<const double>(vp_row + start, count), std::span<PanelDriveSample>(samples.data(), count));
+      for (std::size_t i = 0; i < count; ++i) {
+        const auto k = static_cast<std::size_t>(start) + i;
+        const PanelDriveSample& sample = samples[i];
+        const double x_t = x_row[k];
+        v_row[k] = sample.v;
+        nan |= std::isnan(sample.v);
+        q_row[k] = std::isnan(sample.v) ? std::uint16_t{0} : quantise(sample.v, top);
+        next_row[k] = value_of_code[q_row[k]];
+        if (target_row != nullptr) target_row[k] = sample.target;
+        if (contributed_row != nullptr) contributed_row[k] = sample.reachable ? x_t : sample.contributed;
+        if (sample.reachable) continue;
+        ++unreachable;
+        if (unreachable_row != nullptr) unreachable_row[k] = 255;
+        if (residual_row != nullptr) residual_row[k] += x_t - sample.contributed;
       }
-      const PanelDriveSample& sample = samples[static_cast<std::size_t>(k % kChunk)];
-      v_row[k] = sample.v;
-      nan |= std::isnan(sample.v);
-      q_row[k] = std::isnan(sample.v) ? std::uint16_t{0} : quantise(sample.v, top);
-      next_row[k] = dequantise(q_row[k], top);
-      if (target_row != nullptr) target_row[k] = sample.target;
-      if (contributed_row != nullptr) contributed_row[k] = sample.reachable ? x_t : sample.contributed;
-      if (sample.reachable) continue;
-      ++unreachable;
-      if (unreachable_row != nullptr) unreachable_row[k] = 255;
-      if (residual_row != nullptr) residual_row[k] += x_t - sample.contributed;
     }
     if (nan) tallies.nan_drive[static_cast<std::size_t>(y)] = 1;
     tallies.unreachable[static_cast<std::size_t>(y)] = unreachable;

@@ -62,6 +62,7 @@ class ReferenceDecoder : public HeadsetDecoder {
   DecoderConfig config_;
   PanelEmission emission_;  // the light of every drive code (after every previous code, with history)
   std::optional<OledDriveCodes> oled_codes_;  // OLED without report planes: its codes without a pow per sample
+  std::vector<double> drive_value_of_code_;   // dequantise(q, 2^output_bits - 1) of every drive code q
   std::map<int, EyeState> eyes_;
 };
 
