@@ -16,31 +16,22 @@ PanelShow::PanelShow(const DecoderConfig& config)
   if (!config_.report_planes && !config_.panel.has_history()) oled_codes_.emplace(config_.panel.oled, config_.output_bits);
 }
 
-// The drive codes alone (DecoderConfig::report_planes = false): the same integers as quantise() of the drive plane.
-cv::Mat PanelShow::codes_of(const cv::Mat& wanted) const {
+// An OLED's drive codes without the drive plane (DecoderConfig::report_planes = false): the same integers as quantise()
+// of the plane, and its refusal of NaN.
+cv::Mat PanelShow::oled_codes_of(const cv::Mat& wanted) const {
   cv::Mat codes(wanted.size(), CV_16UC3);
   const auto n = static_cast<std::size_t>(3 * wanted.cols);
-  const int top = (1 << config_.output_bits) - 1;
   for (int y = 0; y < wanted.rows; ++y) {
-    const double* x_row = wanted.ptr<double>(y);
-    std::uint16_t* q_row = codes.ptr<std::uint16_t>(y);
-    if (oled_codes_) {
-      if (!oled_codes_->codes(std::span<const double>(x_row, n), std::span<std::uint16_t>(q_row, n))) {
-        throw std::invalid_argument("quantise: NaN value");
-      }
-      continue;
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-      const double v = config_.panel.drive_from_linear(x_row[k], static_cast<int>(k % 3));
-      if (std::isnan(v)) throw std::invalid_argument("quantise: NaN value");
-      q_row[k] = quantise(v, top);
+    if (!oled_codes_->codes(std::span<const double>(wanted.ptr<double>(y), n),
+                            std::span<std::uint16_t>(codes.ptr<std::uint16_t>(y), n))) {
+      throw std::invalid_argument("quantise: NaN value");
     }
   }
   return codes;
 }
 
 DecodedFrame PanelShow::show(const FrameMeta& meta, const cv::Mat& wanted) {
-  if (!config_.report_planes) return emit(meta, cv::Mat(), cv::Mat(), codes_of(wanted));
+  if (oled_codes_) return emit(meta, cv::Mat(), cv::Mat(), oled_codes_of(wanted));
   cv::Mat drive(wanted.size(), CV_64FC3);
   for (int y = 0; y < wanted.rows; ++y) {
     const auto* x_row = wanted.ptr<cv::Vec3d>(y);
@@ -50,6 +41,7 @@ DecodedFrame PanelShow::show(const FrameMeta& meta, const cv::Mat& wanted) {
     }
   }
   cv::Mat codes = quantise(drive, config_.output_bits);
+  if (!config_.report_planes) return emit(meta, cv::Mat(), cv::Mat(), std::move(codes));
   return emit(meta, wanted.clone(), std::move(drive), std::move(codes));
 }
 

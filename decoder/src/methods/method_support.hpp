@@ -37,7 +37,7 @@ class PanelShow {
 
  private:
   DecodedFrame emit(const FrameMeta& meta, cv::Mat wanted, cv::Mat drive, cv::Mat codes);
-  cv::Mat codes_of(const cv::Mat& wanted) const;
+  cv::Mat oled_codes_of(const cv::Mat& wanted) const;
   DecoderConfig config_;
   PanelEmission emission_;
   std::optional<OledDriveCodes> oled_codes_;  // an OLED without report planes: its codes without a pow per sample
