@@ -1,6 +1,6 @@
 // One whole view of the streaming fixed-point decoder at a headset size (2160x1200, r = 1/2, panorama, drive codes
 // only: what `trm bench` calls `fixed`), full and reduced views timed apart, on 1 and 2 threads (bands of output
-// lines), OLED and LCD; the same for the double reference. Items are output pixels, so items_per_second reads as pixels per second. Each iteration decodes
+// lines), OLED and LCD; the same with the report planes (`fixed+planes`) and for the double reference. Items are output pixels, so items_per_second reads as pixels per second. Each iteration decodes
 // a full view and the reduced view after it; the timed one is the argument's, the other runs with the timer paused
 // (a reduced view needs the full view's stores).
 #include "trm/encoder.hpp"
@@ -82,6 +82,20 @@ void BM_DecodeView(benchmark::State& state) {
 }
 BENCHMARK(BM_DecodeView)
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The same views with the three double report planes and the motion weight statistics, as `trm run`, `trm sweep` and
+// `trm compare` decode them (`trm bench`'s `fixed+planes`). Args: timed view, threads, panel, as BM_DecodeView.
+void BM_DecodeViewWithPlanes(benchmark::State& state) {
+  FixedDecoderConfig config = codes_only(state.range(2) == 0 ? "vive" : "lcd", state.range(1));
+  config.decoder.report_planes = true;
+  config.motion_weight_statistics = true;
+  FixedStreamingDecoder decoder(config);
+  time_views(state, decoder);
+}
+BENCHMARK(BM_DecodeViewWithPlanes)
+    ->ArgsProduct({{0, 1}, {1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -287,7 +287,7 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     // Where nothing reads w and every U node lies in [0, 1], such a line's alpha' is alpha itself (the clamp is
     // never taken, and Eq. 4 adds nothing to the tally): on an OLED its codes are U's nodes' where the composed table
     // applies, else alpha is driven as it is.
-    if (residual_zero && !previous_needed && plans.eotf->within_unit) {
+    if (residual_zero && !previous_needed && plans.eotf->within_unit && codes_alone()) {
       const bool coded =
           blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, out.frame.drive_codes.ptr<std::uint16_t>(y));
       if (!coded && narrow_lines(out)) {
@@ -334,7 +334,8 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
     scratch.first.resize(n);
     scratch.second.resize(n);
     std::uint16_t* codes = out.frame.drive_codes.ptr<std::uint16_t>(y);
-    if (by_runs && narrow_lines(out) && blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, codes)) {
+    if (by_runs && narrow_lines(out) && codes_alone() &&
+        blend_line_codes(in0, in1, g, y, plans, scratch.first_rows, codes)) {
       // On an OLED with the composed table: the line's codes as if its residual were all zero (alpha' = alpha), then
       // alpha, w, Eq. 4 and the codes again on the runs that hold a residual.
       scratch.shown32.resize(n);
@@ -398,11 +399,11 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
 
 namespace {
 
-// The drive codes of output line y by the OLED or the LCD drive kernel, from a line of either width; false where the
-// plans have neither.
+// The drive codes of output line y by the OLED or the LCD drive kernel, from a line of either width; false where
+// neither runs (lcd_kernel: FixedDecoderCore::lcd_drive_kernel).
 template <typename Linear>
-bool drive_line(const FixedKernels& kernels, FrameOutput& out, EyeState& eye, int y, const Linear* shown,
-                Raw* shortfall) {
+bool drive_line(const FixedKernels& kernels, bool lcd_kernel, FrameOutput& out, EyeState& eye, int y,
+                const Linear* shown, Raw* shortfall) {
   const auto n = 3 * static_cast<std::size_t>(eye.full_size.width);
   const FixedLinePlans& plans = kernels.line_plans();
   if (plans.drive) {
@@ -410,7 +411,7 @@ bool drive_line(const FixedKernels& kernels, FrameOutput& out, EyeState& eye, in
     if (shortfall != nullptr) std::fill_n(shortfall, n, Raw{0});
     return true;
   }
-  if (!plans.lcd) return false;
+  if (!lcd_kernel) return false;
   out.tally.counts.lcd_unreachable += lines::lcd_drive(
       shown, n, *plans.lcd, kernels, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
       eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
@@ -420,13 +421,34 @@ bool drive_line(const FixedKernels& kernels, FrameOutput& out, EyeState& eye, in
 
 }  // namespace
 
+template <typename Linear>
+void FixedDecoderCore::report_line(FrameOutput& out, int y, const Linear* shown) const {
+  const std::uint16_t* codes = out.frame.drive_codes.ptr<std::uint16_t>(y);
+  double* wanted = out.frame.wanted_linear.ptr<double>(y);
+  double* drive = out.frame.drive.ptr<double>(y);
+  double* emitted = out.frame.emitted_linear.ptr<double>(y);
+  const int samples = 3 * out.frame.drive_codes.cols;
+  for (int k = 0; k < samples; ++k) {
+    const int ch = k % 3;
+    const Raw value = shown[k];
+    wanted[k] = kernels_.linear_to_double(value);
+    drive[k] = kernels_.drive_to_double(kernels_.drive_value(value, ch));
+    emitted[k] = kernels_.emitted(codes[k], 0, ch);
+  }
+}
+
 void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown,
                                  Raw* shortfall) const {
-  drive_line(kernels_, out, eye, y, shown, shortfall);  // narrow_lines: one of the kernels runs
+  drive_line(kernels_, lcd_drive_kernel(), out, eye, y, shown, shortfall);  // narrow_lines: one of the kernels runs
+  if (config().decoder.report_planes) report_line(out, y, shown);
 }
 
 void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown, Raw* shortfall) const {
-  if (drive_line(kernels_, out, eye, y, shown, shortfall)) return;
+  if (drive_line(kernels_, lcd_drive_kernel(), out, eye, y, shown, shortfall)) {
+    // Only the OLED's kernel runs with report planes (lcd_drive_kernel).
+    if (config().decoder.report_planes) report_line(out, y, shown);
+    return;
+  }
   for (int x = 0; x < eye.full_size.width; ++x) {
     for (int ch = 0; ch < 3; ++ch) {
       const Raw missing = emit(out, eye, y, x, ch, shown[3 * x + ch]);

@@ -332,17 +332,28 @@ class FixedDecoderCore {
   bool narrow_lines(const FrameOutput& out) const {
     const FixedLinePlans& plans = kernels_.line_plans();
     if (!line_values(out) || plans.code_rom32.empty()) return false;
-    return plans.drive ? !plans.drive->base32.empty() : plans.lcd.has_value();
+    return plans.drive ? !plans.drive->base32.empty() : lcd_drive_kernel();
   }
+  // The LCD drive kernel runs where no report planes are wanted: with them, emit drives each sample in raster order
+  // (its drive value and the light after the previous code are the planes' samples).
+  bool lcd_drive_kernel() const {
+    return kernels_.line_plans().lcd.has_value() && !config().decoder.report_planes;
+  }
+  // A line's codes may come without its shown values (U's nodes' codes, FixedLinePlans::drive_of_node): where no
+  // report plane wants those values.
+  bool codes_alone() const { return !config().decoder.report_planes; }
   // The drive codes of output line y from its shown values on a 32-bit line (narrow_lines): the OLED drive kernel,
   // or the LCD's, whose shortfall (where not null) a full frame adds to rho.
   void emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown, Raw* shortfall) const;
-  // The line kernels take a whole line, the OLED drive included: no report planes or taps (emit's other work).
+  // The line kernels take a whole line, the OLED drive included (the report planes then from the line's shown values
+  // and codes, report_line): no taps (the stage records are the per-sample path's).
   bool line_kernels(const FrameOutput& out) const { return line_values(out) && kernels_.line_plans().drive; }
   // A reduced-frame line's shown values over the whole line, emitted afterwards (emit_line): any panel.
-  bool line_values(const FrameOutput& out) const {
-    return kernels_.line_plans().eotf && !config().decoder.report_planes && out.taps == nullptr;
-  }
+  bool line_values(const FrameOutput& out) const { return kernels_.line_plans().eotf && out.taps == nullptr; }
+  // The report planes of output line y (wanted linear, drive value, emitted light) from its shown values and the
+  // drive codes the OLED drive kernel wrote: the samples emit gives them.
+  template <typename Linear>
+  void report_line(FrameOutput& out, int y, const Linear* shown) const;
   // The drive codes of a line's shown values: the OLED drive kernel, the LCD drive kernel, else emit per sample in
   // raster order (the LCD's frame stores). shortfall, where not null, receives each sample's LCD shortfall (0 on an
   // OLED), which a full frame adds to rho (Sec. 4.4).
