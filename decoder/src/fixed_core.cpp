@@ -427,13 +427,25 @@ void FixedDecoderCore::report_line(FrameOutput& out, int y, const Linear* shown)
   double* wanted = out.frame.wanted_linear.ptr<double>(y);
   double* drive = out.frame.drive.ptr<double>(y);
   double* emitted = out.frame.emitted_linear.ptr<double>(y);
-  const int samples = 3 * out.frame.drive_codes.cols;
-  for (int k = 0; k < samples; ++k) {
-    const int ch = k % 3;
-    const Raw value = shown[k];
-    wanted[k] = kernels_.linear_to_double(value);
-    drive[k] = kernels_.drive_to_double(kernels_.drive_value(value, ch));
-    emitted[k] = kernels_.emitted(codes[k], 0, ch);
+  const auto samples = 3 * static_cast<std::size_t>(out.frame.drive_codes.cols);
+  const std::optional<DriveValuePlan>& plan = kernels_.line_plans().drive_value;
+  // A chunk of whole pixels at a time, so that each chunk's samples start at red.
+  constexpr std::size_t kChunk = 3 * 128;
+  std::array<Raw, kChunk> drive_raw;
+  for (std::size_t start = 0; start < samples; start += kChunk) {
+    const std::size_t count = std::min(kChunk, samples - start);
+    if (plan) {
+      lines::drive_values(shown + start, count, *plan, kernels_, drive_raw.data());
+    } else {
+      for (std::size_t i = 0; i < count; ++i) drive_raw[i] = kernels_.drive_value(shown[start + i], static_cast<int>(i % 3));
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t k = start + i;
+      const int ch = static_cast<int>(i % 3);
+      wanted[k] = kernels_.linear_to_double(shown[k]);
+      drive[k] = kernels_.drive_to_double(drive_raw[i]);
+      emitted[k] = kernels_.emitted(codes[k], 0, ch);
+    }
   }
 }
 

@@ -658,6 +658,73 @@ void DriveCodes(const std::int64_t* linear, std::size_t n, const DrivePlan& p, s
   for (; s < n; ++s) out[s] = drive_scalar(linear[s], s, p);
 }
 
+// The OLED's report drive values (FixedKernels::drive_value) on a line of either width: each sample's code x >> shift
+// through its channel's octave ROM as InterpolatedLut::evaluate_raw takes it (the region by the code's leading one,
+// the node and the weight, the word interpolated: LcdDrive's target does the same), 1 exactly from x = one on. Lanes
+// outside [0, one] take the stage function.
+template <typename Linear>
+void DriveValuesOf(const Linear* linear, std::size_t n, const DriveValuePlan& p, const FixedKernels& kernels,
+                   std::int64_t* out) {
+  std::size_t s = 0;
+#if HWY_TARGET == HWY_SCALAR
+  (void)p;
+#else
+  const hn::ScalableTag<std::int64_t> d;
+  const hn::RebindToUnsigned<decltype(d)> du;
+  const hn::Rebind<std::int32_t, decltype(d)> d32;
+  const hn::Rebind<double, decltype(d)> df;
+  const std::size_t lanes = hn::Lanes(d);
+  const auto zero = hn::Zero(d);
+  const auto unit = hn::Set(d, std::int64_t{1});
+  const auto one = hn::Set(d, p.one);
+  const auto full_drive = hn::Set(d, p.full_drive);
+  const auto top_code = hn::Set(d, p.top_code);
+  const auto bottom_bits = hn::Set(d, std::int64_t{p.bottom_region_bits});
+  const auto exponent_bias = hn::Set(d, std::int64_t{1023});
+  // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
+  const int input_shift = p.input_shift;
+  const int segments_log2 = p.segments_per_octave_log2;
+  const std::int64_t* packed = p.packed.data();
+  const std::int64_t* rom_offset = p.rom_offset.data();
+  const std::size_t phase_step = lanes % 3;
+  std::size_t phase = 0;
+  for (; s + lanes <= n; s += lanes, phase = next_phase(phase, phase_step)) {
+    hn::Vec<decltype(d)> x;
+    if constexpr (sizeof(Linear) == 8) {
+      x = hn::LoadU(d, linear + s);
+    } else {
+      x = hn::PromoteTo(d, hn::LoadU(d32, linear + s));
+    }
+    if (!hn::AllFalse(d, hn::Or(hn::Lt(x, zero), hn::Gt(x, one)))) {
+      for (std::size_t i = 0; i < lanes; ++i) out[s + i] = kernels.drive_value(linear[s + i], static_cast<int>((s + i) % 3));
+      continue;
+    }
+    const auto code = hn::Min(hn::ShiftRightSame(x, input_shift), top_code);
+    const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
+    const auto bottom = hn::Lt(lead, bottom_bits);
+    const auto scale_bits = hn::IfThenElse(bottom, bottom_bits, lead);
+    const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
+    const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
+    const auto scaled = hn::ShiftLeftSame(offset, segments_log2);
+    const auto node = hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits));
+    const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
+    const auto word = LookupWords(d, packed, hn::Add(node, hn::LoadU(d, rom_offset + phase)));
+    const auto value = InterpolateWord(d, word, weight, scale_bits);
+    hn::StoreU(hn::IfThenElse(hn::Lt(x, one), value, full_drive), d, out + s);
+  }
+#endif
+  for (; s < n; ++s) out[s] = kernels.drive_value(linear[s], static_cast<int>(s % 3));
+}
+
+void DriveValues(const std::int64_t* linear, std::size_t n, const DriveValuePlan& p, const FixedKernels& kernels,
+                 std::int64_t* out) {
+  DriveValuesOf(linear, n, p, kernels, out);
+}
+void DriveValues32(const std::int32_t* linear, std::size_t n, const DriveValuePlan& p, const FixedKernels& kernels,
+                   std::int64_t* out) {
+  DriveValuesOf(linear, n, p, kernels, out);
+}
+
 // Eq. 2 and the split on lines of either width: the 32-bit lines (beta in [-2^F, 2^(F+1)], F <= 28) take twice the
 // lanes and the clamp by the 32-bit minimum and maximum AVX2 has, where the 64-bit ones are emulated.
 template <typename Linear>
@@ -1810,6 +1877,45 @@ std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
   return plan;
 }
 
+// The OLED's report drive value ROMs as one table (DriveValuePlan), or nothing where a channel's ROM does not fit it.
+// luts: each channel's ROM; input_shift: the linear value's bits below its input code.
+std::optional<DriveValuePlan> drive_value_plan(const std::array<const fx::InterpolatedLut*, 3>& luts, int input_shift,
+                                               std::int64_t one, int drive_frac_bits) {
+  DriveValuePlan plan;
+  plan.one = one;
+  plan.full_drive = std::int64_t{1} << drive_frac_bits;
+  plan.input_shift = input_shift;
+  std::array<std::int64_t, 3> first{};
+  for (int ch = 0; ch < 3; ++ch) {
+    const fx::InterpolatedLut& lut = *luts[static_cast<std::size_t>(ch)];
+    const fx::LutShape& shape = lut.shape();
+    const int segments_log2 = lut.segments_per_octave_log2();
+    // Node (region << S) + (offset << S >> scale) of the top code is (octaves << S) - 1.
+    if (!lut.is_octave_segmented() || shape.rounding != fx::Quant::Rnd || shape.output_signed ||
+        shape.input_bits > 30 || lut.bottom_region_bits() < 1 ||
+        lut.rom().size() < (static_cast<std::size_t>(shape.octaves) << segments_log2)) {
+      return std::nullopt;
+    }
+    if (ch > 0 && (shape.input_bits != luts[0]->shape().input_bits ||
+                   segments_log2 != plan.segments_per_octave_log2 ||
+                   lut.bottom_region_bits() != plan.bottom_region_bits)) {
+      return std::nullopt;
+    }
+    plan.top_code = (std::int64_t{1} << shape.input_bits) - 1;
+    plan.bottom_region_bits = lut.bottom_region_bits();
+    plan.segments_per_octave_log2 = segments_log2;
+    const std::vector<std::int64_t>& rom = lut.rom();
+    std::vector<std::int64_t> step(rom.size(), 0);
+    for (std::size_t i = 0; i + 1 < rom.size(); ++i) step[i] = rom[i + 1] - rom[i];
+    std::optional<std::vector<std::int64_t>> packed = packed_rom(rom, step);
+    if (!packed) return std::nullopt;
+    first[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(plan.packed.size());
+    plan.packed.insert(plan.packed.end(), packed->begin(), packed->end());
+  }
+  for (int i = 0; i < 3 + DrivePlan::kMaxLanes; ++i) plan.rom_offset.push_back(first[static_cast<std::size_t>(i % 3)]);
+  return plan;
+}
+
 // The motion test's plan: every product of MotionWeights / AddWeightedResiduals of 32-bit operands (F <= 30, the
 // weights, s, the ROM words and the mantissa below 2^32), every rounding shift at least 1.
 std::optional<MotionPlan> motion_plan(const FixedKernels& kernels, const std::array<std::int64_t, 3>& luma_weights,
@@ -1957,6 +2063,9 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
   }
   if (!kernels.lcd()) {
     plans.drive = drive_plan({&kernels.drive_index(0), &kernels.drive_index(1), &kernels.drive_index(2)});
+    plans.drive_value = drive_value_plan({kernels.drive_luts_[0].get(), kernels.drive_luts_[1].get(),
+                                          kernels.drive_luts_[2].get()},
+                                         kernels.drive_lut_shift_, kernels.one(), c.drive_frac_bits);
   }
   if (plans.drive && plans.eotf && plans.eotf->within_unit && !plans.eotf->node32.empty() &&
       plans.eotf->node32.size() <= (std::size_t{1} << 17)) {
@@ -2425,6 +2534,8 @@ HWY_EXPORT(TargetName);
 HWY_EXPORT(BlendRowsEotf32);
 HWY_EXPORT(BlendRowsDriveExact);
 HWY_EXPORT(DriveCodes32);
+HWY_EXPORT(DriveValues);
+HWY_EXPORT(DriveValues32);
 HWY_EXPORT(Compensate32);
 HWY_EXPORT(AddWeightedResidualsInto32);
 HWY_EXPORT(StoreResiduals32);
@@ -2456,6 +2567,14 @@ void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& pla
 }
 void drive_codes(const std::int32_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out) {
   HWY_DYNAMIC_DISPATCH(DriveCodes32)(linear, n, plan, out);
+}
+void drive_values(const std::int64_t* linear, std::size_t n, const DriveValuePlan& plan, const FixedKernels& kernels,
+                  std::int64_t* out) {
+  HWY_DYNAMIC_DISPATCH(DriveValues)(linear, n, plan, kernels, out);
+}
+void drive_values(const std::int32_t* linear, std::size_t n, const DriveValuePlan& plan, const FixedKernels& kernels,
+                  std::int64_t* out) {
+  HWY_DYNAMIC_DISPATCH(DriveValues32)(linear, n, plan, kernels, out);
 }
 std::uint64_t compensate(const std::uint16_t* codes, const std::int64_t* low, std::size_t n,
                          const FixedLinePlans& plans, std::int64_t* shown, std::int64_t* rho) {

@@ -127,6 +127,22 @@ struct DrivePlan {
   int offset_bits = 0;
 };
 
+// The OLED's report drive value v = x^(1/gamma) (FixedKernels::drive_value) of the three channels for interleaved
+// samples: each channel's octave-segmented ROM (InterpolatedLut::evaluate_raw) as packed words (EotfPlan::packed),
+// one channel after the other. Built where every channel's ROM has a bottom region, rounds half up, is unsigned, packs
+// (packed_rom) and holds every node its codes reach, and its input code is at most 30 bits (the weight is then a
+// 32-bit operand); nothing otherwise (drive_value per sample).
+struct DriveValuePlan {
+  std::vector<std::int64_t> packed;
+  std::vector<std::int64_t> rom_offset;  // element i: channel i mod 3's first word, i < 3 + DrivePlan::kMaxLanes
+  int input_shift = 0;                   // the linear value's bits below the ROM's input code
+  std::int64_t top_code = 0;             // 2^input_bits - 1
+  int bottom_region_bits = 0;
+  int segments_per_octave_log2 = 0;
+  std::int64_t one = 0;         // 1.0 as uQ1.F: from it on, v is 1 exactly
+  std::int64_t full_drive = 0;  // 1.0 as uQ1.drive_frac_bits
+};
+
 // D's horizontal half over a line (FixedKernels::gaussian_horizontal_line, encoded space), one entry per reduced
 // output sample s = 3k + ch of tap slot t at [t n + s] (n = 3 reduced.width): the row sample the tap reads and its
 // weight, uQ0.T; slots past a column's own taps weigh 0. Each exact sum stays below max_code 2^T < 2^32.
@@ -262,6 +278,7 @@ void lcd_composed_index(LcdPlan& plan, const fx::InterpolatedLut& target);
 struct FixedLinePlans {
   std::optional<EotfPlan> eotf;    // encoded-space U and EOTF (8-bit sums, W <= 24, 2W > U, interpolation on 64 bits)
   std::optional<DrivePlan> drive;  // OLED drive codes
+  std::optional<DriveValuePlan> drive_value;  // the OLED's report drive values
   std::optional<MotionPlan> motion;  // finite, non-zero s; uniform reciprocal and exp ROMs with power-of-two steps
   std::optional<GaussianPlan> gaussian;  // encoded space, max_code 2^T and max_code 2^L below 2^32
   std::optional<LcdPlan> lcd;            // LCD with the merge table (output codes up to 8 bits), F <= 30
@@ -305,6 +322,11 @@ bool blend_rows_drive(const std::uint32_t* top, const std::uint32_t* bottom, std
                       std::uint16_t* codes);
 // out[s] = the drive code of linear[s] (channel s mod 3), as ThresholdIndex::search gives it.
 void drive_codes(const std::int64_t* linear, std::size_t n, const DrivePlan& plan, std::uint16_t* out);
+// out[s] = FixedKernels::drive_value(linear[s], s mod 3), the OLED's report drive value, on a line of either width.
+void drive_values(const std::int64_t* linear, std::size_t n, const DriveValuePlan& plan, const FixedKernels& kernels,
+                  std::int64_t* out);
+void drive_values(const std::int32_t* linear, std::size_t n, const DriveValuePlan& plan, const FixedKernels& kernels,
+                  std::int64_t* out);
 // Eq. 2 and the split (FixedKernels::compensate): beta = 2 lin(codes[s]) - low[s] (lin through plans.code_rom),
 // shown[s] = clamp(beta, 0, one),
 // rho[s] = beta - shown[s]. Returns the number of clipped samples (beta outside [0, one]).

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -609,6 +610,79 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
   }
 }
 
+// The OLED's report drive values (the planes trm run reads) against FixedKernels::drive_value: codes at each octave's
+// and each segment's ends and either side of them, with and without the bits below the ROM's input code, random
+// values, 0 and 1, and values outside [0, 1] (the stage function), on lines of both widths, at two output depths, at
+// F = 20 (no bits below the code) and with 8 and 64 segments per octave.
+TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
+  std::vector<FixedDecoderConfig> configs = {fixed_config(link_config(0.5), "vive"),
+                                             fixed_config(link_config(0.5), "rift", 10)};
+  configs.push_back(configs[0]);
+  configs.back().linear_frac_bits = 20;
+  configs.back().residual.frac_bits = 20;
+  configs.push_back(configs[0]);
+  configs.back().drive_segments_per_octave = 8;
+  configs.push_back(configs[1]);
+  configs.back().drive_segments_per_octave = 64;
+  for (const FixedDecoderConfig& config : configs) {
+    const fixed_detail::FixedKernels kernels(config);
+    ASSERT_TRUE(kernels.line_plans().drive_value.has_value());
+    const fixed_detail::DriveValuePlan& plan = *kernels.line_plans().drive_value;
+    const std::int64_t one = kernels.one();
+    const int shift = plan.input_shift;
+    const int input_bits = std::bit_width(static_cast<std::uint64_t>(plan.top_code));
+    // Values outside the kernel's lanes first and last, so that the vectors between keep their channel phase.
+    std::vector<std::int64_t> values = {-1, one + 1, std::int64_t{1} << 40};
+    const std::int64_t segments = std::int64_t{1} << plan.segments_per_octave_log2;
+    for (int k = 0; k < input_bits; ++k) {
+      const std::int64_t start = std::int64_t{1} << k;
+      for (std::int64_t j = 0; j <= segments; ++j) {
+        const std::int64_t code = start + j * start / segments;
+        for (const std::int64_t c : {code - 1, code, code + 1}) {
+          for (const std::int64_t low : {std::int64_t{0}, (std::int64_t{1} << shift) - 1}) {
+            const std::int64_t v = (c << shift) + low;
+            if (v >= 0 && v <= one) values.push_back(v);
+          }
+        }
+      }
+    }
+    std::mt19937_64 random(31);
+    std::uniform_int_distribution<std::int64_t> linear(0, one);
+    for (int i = 0; i < 20000; ++i) values.push_back(linear(random));
+    for (const std::int64_t v : {std::int64_t{0}, one - 1, one, one + 1, std::int64_t{-5}}) values.push_back(v);
+    std::vector<std::int64_t> expected(values.size());
+    for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_value(values[s], static_cast<int>(s % 3));
+    std::vector<std::int32_t> values32;
+    std::vector<std::int64_t> expected32;
+    for (std::size_t s = 0; s < values.size(); ++s) {
+      if (values[s] > std::numeric_limits<std::int32_t>::max()) continue;
+      while (values32.size() % 3 != s % 3) {
+        values32.push_back(static_cast<std::int32_t>(one / 3));
+        expected32.push_back(kernels.drive_value(one / 3, static_cast<int>((values32.size() - 1) % 3)));
+      }
+      values32.push_back(static_cast<std::int32_t>(values[s]));
+      expected32.push_back(expected[s]);
+    }
+    const std::string what = config.decoder.panel.name + " F=" + std::to_string(config.linear_frac_bits) + " " +
+                             std::to_string(config.drive_segments_per_octave) + " segments per octave";
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      std::vector<std::int64_t> drive(values.size());
+      fixed_detail::lines::drive_values(values.data(), values.size(), plan, kernels, drive.data());
+      for (std::size_t s = 0; s < values.size(); ++s) {
+        ASSERT_EQ(drive[s], expected[s]) << hwy::TargetName(target) << " " << what << " sample " << s << " value "
+                                         << values[s];
+      }
+      std::vector<std::int64_t> drive32(values32.size());
+      fixed_detail::lines::drive_values(values32.data(), values32.size(), plan, kernels, drive32.data());
+      for (std::size_t s = 0; s < values32.size(); ++s) {
+        ASSERT_EQ(drive32[s], expected32[s]) << hwy::TargetName(target) << " " << what << " on a 32-bit line, sample "
+                                             << s << " value " << values32[s];
+      }
+    }
+  }
+}
+
 // ROMs with thresholds where a float conversion or a bucket's bounds could go wrong, up to the index's 2^30, through
 // the two-gather search and the packed single gather:
 //   * ends: at 2^k - 1, 2^k and the second bucket of each octave, 2^k + 2^(k-7): the last value of an octave and of
@@ -1026,6 +1100,7 @@ TEST(FixedLines, PlansCoverTheDefaultFormatsAndStepAsideOtherwise) {
   const FixedDecoderConfig oled = fixed_config(link_config(0.5), "vive");
   EXPECT_TRUE(plans_of(oled).eotf.has_value());
   EXPECT_TRUE(plans_of(oled).drive.has_value());
+  EXPECT_TRUE(plans_of(oled).drive_value.has_value());
   EXPECT_TRUE(plans_of(oled).motion.has_value());
   EXPECT_TRUE(plans_of(oled).gaussian.has_value());
   EXPECT_FALSE(plans_of(oled).drive->packed32.empty()) << "the OLED drive search in one lookup at 8 bits";
