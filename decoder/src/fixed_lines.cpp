@@ -134,6 +134,29 @@ HWY_INLINE hn::Vec<D> InterpolateWord(D d, hn::Vec<D> word, hn::Vec<D> weight, S
   }
 }
 
+// The place of input code `code` (below 2^53) in an octave-segmented ROM, as InterpolatedLut::evaluate_raw finds it:
+// the region by the code's leading one (read from its double's exponent; the bottom region holds the codes below
+// 2^bottom_bits), the node and the weight over 2^scale_bits, for InterpolateWord.
+template <class D>
+struct OctavePlace {
+  hn::Vec<D> node, weight, scale_bits;
+};
+template <class D>
+HWY_INLINE OctavePlace<D> OctaveRomPlace(D d, hn::Vec<D> code, hn::Vec<D> bottom_bits, int segments_log2) {
+  const hn::RebindToUnsigned<D> du;
+  const hn::Rebind<double, D> df;
+  const auto unit = hn::Set(d, hn::TFromD<D>{1});
+  const auto lead =
+      hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), hn::Set(d, hn::TFromD<D>{1023}));
+  const auto bottom = hn::Lt(lead, bottom_bits);
+  const auto scale_bits = hn::IfThenElse(bottom, bottom_bits, lead);
+  const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
+  const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
+  const auto scaled = hn::ShiftLeftSame(offset, segments_log2);
+  return OctavePlace<D>{hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits)),
+                        hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit)), scale_bits};
+}
+
 // first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1].
 template <class D>
 HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn::Vec<D>& first, hn::Vec<D>& second) {
@@ -675,12 +698,10 @@ void DriveValuesOf(const Linear* linear, std::size_t n, const DriveValuePlan& p,
   const hn::Rebind<double, decltype(d)> df;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
-  const auto unit = hn::Set(d, std::int64_t{1});
   const auto one = hn::Set(d, p.one);
   const auto full_drive = hn::Set(d, p.full_drive);
   const auto top_code = hn::Set(d, p.top_code);
   const auto bottom_bits = hn::Set(d, std::int64_t{p.bottom_region_bits});
-  const auto exponent_bias = hn::Set(d, std::int64_t{1023});
   // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
   const int input_shift = p.input_shift;
   const int segments_log2 = p.segments_per_octave_log2;
@@ -700,16 +721,9 @@ void DriveValuesOf(const Linear* linear, std::size_t n, const DriveValuePlan& p,
       continue;
     }
     const auto code = hn::Min(hn::ShiftRightSame(x, input_shift), top_code);
-    const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
-    const auto bottom = hn::Lt(lead, bottom_bits);
-    const auto scale_bits = hn::IfThenElse(bottom, bottom_bits, lead);
-    const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
-    const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
-    const auto scaled = hn::ShiftLeftSame(offset, segments_log2);
-    const auto node = hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits));
-    const auto weight = hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit));
-    const auto word = LookupWords(d, packed, hn::Add(node, hn::LoadU(d, rom_offset + phase)));
-    const auto value = InterpolateWord(d, word, weight, scale_bits);
+    const auto place = OctaveRomPlace(d, code, bottom_bits, segments_log2);
+    const auto word = LookupWords(d, packed, hn::Add(place.node, hn::LoadU(d, rom_offset + phase)));
+    const auto value = InterpolateWord(d, word, place.weight, place.scale_bits);
     hn::StoreU(hn::IfThenElse(hn::Lt(x, one), value, full_drive), d, out + s);
   }
 #endif
@@ -1307,19 +1321,10 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
   // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one, the node and the
   // weight, then the node's word interpolated. (A sum of 2 or more reads 1, not the ROM: its code is clamped as
   // evaluate_raw clamps it.)
-  struct RomPlace {
-    hn::Vec<decltype(d)> node, weight, scale_bits;
-  };
+  using RomPlace = OctavePlace<std::remove_const_t<decltype(d)>>;
   const auto target_place = [&](const auto sum) {
     const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), target_shift), top_code);
-    const auto lead = hn::Sub(hn::BitCast(d, hn::ShiftRight<52>(hn::BitCast(du, hn::ConvertTo(df, code)))), exponent_bias);
-    const auto bottom = hn::Lt(lead, bottom_bits);
-    const auto scale_bits = hn::IfThenElse(bottom, bottom_bits, lead);
-    const auto region = hn::IfThenZeroElse(bottom, hn::Add(hn::Sub(lead, bottom_bits), unit));
-    const auto offset = hn::IfThenElse(bottom, code, hn::Sub(code, hn::Shl(unit, hn::IfThenZeroElse(bottom, lead))));
-    const auto scaled = hn::ShiftLeftSame(offset, segments_log2);
-    return RomPlace{hn::Add(hn::ShiftLeftSame(region, segments_log2), hn::Shr(scaled, scale_bits)),
-                    hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit)), scale_bits};
+    return OctaveRomPlace(d, code, bottom_bits, segments_log2);
   };
   const auto target_from = [&](const auto sum, const auto word, const auto weight, const auto scale_bits) {
     const auto rom_target = InterpolateWord(d, word, weight, scale_bits);

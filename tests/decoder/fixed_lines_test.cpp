@@ -534,6 +534,32 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
 // Both output depths: at 10 bits the index needs up to three steps (the base gather and three threshold gathers); at
 // 8 bits one, which takes the packed single gather (DrivePlan::packed32), and the stepped search of the same tables
 // beside it.
+// result_of(values[s], s mod 3) for every sample s (sample s is read as channel s mod 3).
+template <typename Result>
+auto per_channel(const std::vector<std::int64_t>& values, const Result& result_of) {
+  std::vector<decltype(result_of(std::int64_t{0}, 0))> out;
+  for (std::size_t s = 0; s < values.size(); ++s) out.push_back(result_of(values[s], static_cast<int>(s % 3)));
+  return out;
+}
+
+// The values a 32-bit line holds, each at its own channel's place (`filler` put before it where a value left out
+// would shift it), and their results.
+template <typename Result>
+auto on_32bit_line(const std::vector<std::int64_t>& values, std::int64_t filler, const Result& result_of) {
+  std::vector<std::int32_t> values32;
+  std::vector<decltype(result_of(std::int64_t{0}, 0))> expected32;
+  for (std::size_t s = 0; s < values.size(); ++s) {
+    if (values[s] > std::numeric_limits<std::int32_t>::max()) continue;
+    while (values32.size() % 3 != s % 3) {
+      expected32.push_back(result_of(filler, static_cast<int>(values32.size() % 3)));
+      values32.push_back(static_cast<std::int32_t>(filler));
+    }
+    expected32.push_back(result_of(values[s], static_cast<int>(s % 3)));
+    values32.push_back(static_cast<std::int32_t>(values[s]));
+  }
+  return std::make_pair(values32, expected32);
+}
+
 TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
   for (const int output_bits : {10, 8}) {
     const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive", output_bits);
@@ -573,20 +599,10 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
     values.push_back(-1);
     values.push_back(one + 1);
     values.push_back(std::int64_t{1} << 40);
-    std::vector<std::uint16_t> expected(values.size());
-    for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_code(values[s], static_cast<int>(s % 3));
+    const auto code_of = [&](std::int64_t v, int ch) { return kernels.drive_code(v, ch); };
+    const std::vector<std::uint16_t> expected = per_channel(values, code_of);
     // The 32-bit lines (the 32-bit tables only): the same values but 2^40, which no 32-bit line holds.
-    std::vector<std::int32_t> values32;
-    std::vector<std::uint16_t> expected32;
-    for (std::size_t s = 0; s < values.size(); ++s) {
-      if (values[s] > std::numeric_limits<std::int32_t>::max()) continue;
-      while (values32.size() % 3 != s % 3) {
-        values32.push_back(static_cast<std::int32_t>(one / 2));
-        expected32.push_back(kernels.drive_code(one / 2, static_cast<int>((values32.size() - 1) % 3)));
-      }
-      values32.push_back(static_cast<std::int32_t>(values[s]));
-      expected32.push_back(expected[s]);
-    }
+    const auto [values32, expected32] = on_32bit_line(values, one / 2, code_of);
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
       const TargetMock mock(target);
       for (const fixed_detail::DrivePlan* plan : {&narrow, &unpacked, &wide}) {
@@ -650,19 +666,9 @@ TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
     std::uniform_int_distribution<std::int64_t> linear(0, one);
     for (int i = 0; i < 20000; ++i) values.push_back(linear(random));
     for (const std::int64_t v : {std::int64_t{0}, one - 1, one, one + 1, std::int64_t{-5}}) values.push_back(v);
-    std::vector<std::int64_t> expected(values.size());
-    for (std::size_t s = 0; s < values.size(); ++s) expected[s] = kernels.drive_value(values[s], static_cast<int>(s % 3));
-    std::vector<std::int32_t> values32;
-    std::vector<std::int64_t> expected32;
-    for (std::size_t s = 0; s < values.size(); ++s) {
-      if (values[s] > std::numeric_limits<std::int32_t>::max()) continue;
-      while (values32.size() % 3 != s % 3) {
-        values32.push_back(static_cast<std::int32_t>(one / 3));
-        expected32.push_back(kernels.drive_value(one / 3, static_cast<int>((values32.size() - 1) % 3)));
-      }
-      values32.push_back(static_cast<std::int32_t>(values[s]));
-      expected32.push_back(expected[s]);
-    }
+    const auto value_of = [&](std::int64_t v, int ch) { return kernels.drive_value(v, ch); };
+    const std::vector<std::int64_t> expected = per_channel(values, value_of);
+    const auto [values32, expected32] = on_32bit_line(values, one / 3, value_of);
     const std::string what = config.decoder.panel.name + " F=" + std::to_string(config.linear_frac_bits) + " " +
                              std::to_string(config.drive_segments_per_octave) + " segments per octave";
     for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
