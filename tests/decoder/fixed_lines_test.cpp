@@ -629,7 +629,7 @@ TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
 // The OLED's report drive values (the planes trm run reads) against FixedKernels::drive_value: codes at each octave's
 // and each segment's ends and either side of them, with and without the bits below the ROM's input code, random
 // values, 0 and 1, and values outside [0, 1] (the stage function), on lines of both widths, at two output depths, at
-// F = 20 (no bits below the code) and with 8 and 64 segments per octave.
+// F = 20 (no bits below the code), F = 26 (two) and the default 28 (four), with 1, 8, 32 and 64 segments per octave.
 TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
   std::vector<FixedDecoderConfig> configs = {fixed_config(link_config(0.5), "vive"),
                                              fixed_config(link_config(0.5), "rift", 10)};
@@ -640,6 +640,11 @@ TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
   configs.back().drive_segments_per_octave = 8;
   configs.push_back(configs[1]);
   configs.back().drive_segments_per_octave = 64;
+  configs.push_back(configs[0]);  // one segment an octave, the widest drive words, two bits below the ROM's input
+  configs.back().drive_segments_per_octave = 1;
+  configs.back().drive_frac_bits = 24;
+  configs.back().linear_frac_bits = 26;
+  configs.back().residual.frac_bits = 26;
   for (const FixedDecoderConfig& config : configs) {
     const fixed_detail::FixedKernels kernels(config);
     ASSERT_TRUE(kernels.line_plans().drive_value.has_value());

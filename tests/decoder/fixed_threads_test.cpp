@@ -116,7 +116,7 @@ TEST(FixedThreads, ViewsWithLostLinesAndLostViewsMatchOnePipeline) {
 TEST(FixedThreads, MoreBandsThanThreadsGiveTheOnePipelineBits) {
   for (const std::string& panel : {std::string("vive"), std::string("lcd")}) {
     FixedDecoderConfig config = fixed_config(link_config(0.5, 0, true), panel);
-    config.decoder.report_planes = false;  // the line kernels' path, as a feed runs it
+    config.decoder.report_planes = false;  // drive codes only, as a feed decodes
     config.motion_weight_statistics = false;
     expect_bands_identical(encode_sequence(scene_images("discs", kWidth, 640, 4), link_config(0.5, 0, true)), config,
                            "tall discs " + panel);
