@@ -7,8 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <span>
 #include <stdexcept>
+#include <vector>
 
 namespace trm {
 
@@ -36,6 +39,47 @@ cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output
         const double code = std::floor(std::clamp(v, 0.0, 1.0) * levels + 0.5);
         dst[x][c] = panel.linear_from_drive(code / levels, c);
       }
+    }
+  }
+  return out;
+}
+
+FullRateEmission::FullRateEmission(const Panel& panel, int output_bits)
+    : panel_(panel), top_((1 << output_bits) - 1), emission_(panel, output_bits) {
+  if (panel.kind == PanelKind::Oled) oled_codes_.emplace(panel.oled, output_bits);
+}
+
+cv::Mat FullRateEmission::operator()(const cv::Mat& linear) const {
+  if (linear.type() != CV_64FC3) throw std::invalid_argument("FullRateEmission: the frame must be CV_64FC3");
+  cv::Mat out(linear.size(), CV_64FC3);
+  const auto samples = static_cast<std::size_t>(3 * linear.cols);
+  std::vector<std::uint16_t> codes(samples);
+  // full_rate_emission's expression, where a drive value is NaN (the tables have no code for it).
+  const auto per_sample = [&](double x, int c) {
+    const double v = panel_.drive_from_linear(x, c);
+    const double code = std::floor(std::clamp(v, 0.0, 1.0) * top_ + 0.5);
+    return panel_.linear_from_drive(code / top_, c);
+  };
+  for (int y = 0; y < linear.rows; ++y) {
+    const double* src = linear.ptr<double>(y);
+    double* dst = out.ptr<double>(y);
+    if (oled_codes_) {
+      if (oled_codes_->codes(std::span<const double>(src, samples), codes)) {
+        emission_.row(codes, std::span<double>(dst, samples));
+      } else {
+        for (std::size_t k = 0; k < samples; ++k) dst[k] = per_sample(src[k], static_cast<int>(k % 3));
+      }
+      continue;
+    }
+    for (std::size_t k = 0; k < samples; ++k) {
+      const int c = static_cast<int>(k % 3);
+      const double v = panel_.drive_from_linear(src[k], c);
+      if (std::isnan(v)) {
+        dst[k] = per_sample(src[k], c);
+        continue;
+      }
+      const std::uint16_t code = quantise(v, top_);  // floor(clamp(v) top + 1/2), held: the previous code is this one
+      dst[k] = emission_(code, code, c);
     }
   }
   return out;

@@ -9,10 +9,14 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace trm {
 namespace {
@@ -76,6 +80,47 @@ TEST(FullRateEmission, IsTheLightOfTheNearestDriveCode) {
     EXPECT_NEAR(emitted.at<cv::Vec3d>(0, 0)[c], on_100, 1e-15);
     EXPECT_NEAR(emitted.at<cv::Vec3d>(0, 1)[c], on_100, 1e-15);
     EXPECT_NEAR(emitted.at<cv::Vec3d>(0, 2)[c], on_101, 1e-15);
+  }
+}
+
+// The tables' form against the per-sample one, bit for bit: every code's crossing and the doubles either side of it,
+// random values, the ends, values outside [0, 1] and NaN, OLED and LCD panels at 8 and 10 bits.
+TEST(FullRateEmission, TheTablesGiveThePerSampleDoubles) {
+  for (const std::string spec : {"vive", "rift", "gamma:0.5,2.2,4", "lcd", "lcd:0.3,0.1,0.3,0,2.4"}) {
+    const Panel panel = parse_panel(spec);
+    for (const int bits : {8, 10}) {
+      const int top = (1 << bits) - 1;
+      std::vector<double> values;
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k <= top; ++k) {
+          // The linear value whose drive is half a code below k (a crossing), and its neighbours.
+          const double crossing = panel.linear_from_drive(std::max(0.0, (k - 0.5) / top), c);
+          for (double x = std::nextafter(std::nextafter(crossing, 0.0), 0.0), i = 0; i < 5; ++i, x = std::nextafter(x, 2.0)) {
+            while (values.size() % 3 != static_cast<std::size_t>(c)) values.push_back(0.5);
+            values.push_back(x);
+          }
+        }
+      }
+      std::mt19937_64 random(7);
+      std::uniform_real_distribution<double> unit(0.0, 1.0);
+      for (int i = 0; i < 3000; ++i) values.push_back(unit(random));
+      for (const double x : {0.0, -0.0, 1.0, -1e-300, 1.5, -2.0, std::numeric_limits<double>::quiet_NaN(),
+                             std::numeric_limits<double>::infinity(), 5e-324}) {
+        values.push_back(x);
+      }
+      while (values.size() % 3 != 0) values.push_back(0.25);
+      const cv::Mat linear = cv::Mat(values, true).reshape(3, 1);
+      const cv::Mat expected = full_rate_emission(linear, panel, bits);
+      const cv::Mat tables = FullRateEmission(panel, bits)(linear);
+      ASSERT_EQ(tables.type(), CV_64FC3);
+      ASSERT_EQ(tables.size(), expected.size());
+      const double* a = expected.ptr<double>(0);
+      const double* b = tables.ptr<double>(0);
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        ASSERT_TRUE(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))
+            << spec << " " << bits << "-bit sample " << k << " x = " << values[k] << ": " << a[k] << " against " << b[k];
+      }
+    }
   }
 }
 

@@ -57,6 +57,7 @@ class MethodMeter {
   MethodMeter(const Panel& panel, int output_bits, int scan_line, double pixels_per_degree, double refresh_hz)
       : panel_(panel),
         output_bits_(output_bits),
+        full_rate_(panel, output_bits),
         scan_line_(scan_line),
         refresh_hz_(refresh_hz),
         pairs_(panel),
@@ -71,7 +72,7 @@ class MethodMeter {
     pixels_rendered_ += static_cast<double>(view.pixels_rendered);
     pixels_sent_ += view.sent ? static_cast<double>(view.sent->codes.total()) : 0.0;
 
-    const cv::Mat reference = full_rate_emission(*view.linear_full, panel_, output_bits_);
+    const cv::Mat reference = full_rate_(*view.linear_full);
     const cv::Mat luma_emitted = luma(shown.emitted_linear);
     const cv::Mat luma_reference = luma(reference);
     luma_sum_ += cv::sum(luma_emitted)[0];
@@ -145,6 +146,7 @@ class MethodMeter {
 
   const Panel& panel_;
   int output_bits_;
+  FullRateEmission full_rate_;  // each view's full-rate reference
   int scan_line_;
   double refresh_hz_;
   PairTracker pairs_;

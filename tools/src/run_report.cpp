@@ -68,6 +68,7 @@ void JsonLinesWriter::close() { file_.commit(); }
 RunRecorder::RunRecorder(const PipelineOptions& options, const std::filesystem::path& directory)
     : options_(options),
       panel_(options.panel),
+      full_rate_(options.panel, options.output_bits),
       pairs_tracker_(options.panel),
       view_records_(directory / "views.jsonl"),
       pair_records_(directory / "pairs.jsonl") {}
@@ -153,7 +154,7 @@ cv::Mat RunRecorder::add(const DecodedView& view) {
   view_records_.write(rec);
   ++views_;
 
-  const cv::Mat reference = full_rate_emission(*view.linear_full, panel_, options_.output_bits);
+  const cv::Mat reference = full_rate_(*view.linear_full);
   cv::Mat perceived;
   if (const auto pair = pairs_tracker_.add(meta.eye, meta.index, d.emitted_linear, reference)) {
     perceived = pair->perceived;

@@ -63,6 +63,7 @@ class RunRecorder {
 
   PipelineOptions options_;
   Panel panel_;
+  FullRateEmission full_rate_;  // each view's full-rate reference
   PairTracker pairs_tracker_;
   JsonLinesWriter view_records_;
   JsonLinesWriter pair_records_;

@@ -3,6 +3,7 @@
 // over cv::Mat (or a running record of them) so that reports, the sweep and the tests measure with the same code.
 #pragma once
 
+#include "trm/oled_drive_codes.hpp"
 #include "trm/panel.hpp"
 
 #include <opencv2/core.hpp>
@@ -26,6 +27,21 @@ cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, cons
 // resolution: the double-precision drive of each value, rounded to output_bits like any decoder's, emitted back.
 // The pair of two such frames is the full-rate reference a reduced-rate method's perceived pair is held to.
 cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits);
+
+// full_rate_emission of one panel and output depth with its tables built once, the same doubles: an OLED's codes from
+// where each code begins (OledDriveCodes) instead of a pow per sample, and every code's light from PanelEmission (an
+// LCD's as held: M(v, v)^gamma) instead of a second one. For a report that takes the reference of every view.
+class FullRateEmission {
+ public:
+  FullRateEmission(const Panel& panel, int output_bits);
+  cv::Mat operator()(const cv::Mat& linear) const;
+
+ private:
+  Panel panel_;
+  int top_;
+  std::optional<OledDriveCodes> oled_codes_;  // an OLED's
+  PanelEmission emission_;
+};
 
 // Frame pairs as the eye sees them at a fixed gaze, per eye. Views come in slot order with their emitted light and
 // the full-rate reference's emission (full_rate_emission of the scene at that t); a view that completes a pair
