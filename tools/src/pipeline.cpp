@@ -42,8 +42,11 @@ PipelineResult run_pipeline(const PipelineOptions& options, const std::function<
   const bool compare = options.compare_reference && decoder != nullptr && setup.impl != "reference";
   MethodSetup reference_setup = setup;
   reference_setup.impl = "reference";
+  // The reference beside is held to the decoder by its drive codes alone (DESIGN §6): it makes no report planes.
+  MethodSetup codes_reference_setup = reference_setup;
+  codes_reference_setup.decoder.decoder.report_planes = false;
   std::unique_ptr<MethodDisplay> reference_beside;
-  if (compare) reference_beside = method.method->make_display(reference_setup);
+  if (compare) reference_beside = method.method->make_display(codes_reference_setup);
   // LCD codes compared free-running drift apart by the design's neutral mode (see adopt_panel_history); the
   // synchronised comparison is the criterion, the free-running one is reported beside it.
   std::unique_ptr<MethodDisplay> free_running;

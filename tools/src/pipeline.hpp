@@ -21,7 +21,8 @@ struct DecodedView {
   const LinkFrame* sent = nullptr;        // what crossed the link; null when the method sends nothing in this slot
   std::int64_t pixels_rendered = 0;       // what the method's GPU side rendered for this view
   const DecodedFrame* decoded = nullptr;  // what the headset showed
-  // The reference decoder's output, when compared beside a fixed impl. LCD: the reference takes the fixed
+  // The reference decoder's output (drive codes and statistics, no report planes), when compared beside a fixed
+  // impl. LCD: the reference takes the fixed
   // decoder's drive codes as its panel history after every frame (ReferenceDecoder::adopt_panel_history), so each
   // frame's inverse is compared from the same panel state; free_running_reference keeps its own history.
   const DecodedFrame* reference = nullptr;
