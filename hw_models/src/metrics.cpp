@@ -11,6 +11,7 @@
 #include <limits>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace trm {
@@ -44,9 +45,17 @@ cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output
   return out;
 }
 
-FullRateEmission::FullRateEmission(const Panel& panel, int output_bits)
-    : panel_(panel), top_((1 << output_bits) - 1), emission_(panel, output_bits) {
+FullRateEmission::FullRateEmission(const Panel& panel, int output_bits) : panel_(panel) {
+  if (output_bits < 1 || output_bits > 16) {
+    throw std::invalid_argument("FullRateEmission: output bits must be in [1, 16], got " + std::to_string(output_bits));
+  }
+  top_ = (1 << output_bits) - 1;
   if (panel.kind == PanelKind::Oled) oled_codes_.emplace(panel.oled, output_bits);
+  for (int c = 0; c < 3; ++c) {
+    for (int code = 0; code <= top_; ++code) {
+      held_light_[static_cast<std::size_t>(c)].push_back(panel.linear_from_drive(static_cast<double>(code) / top_, c));
+    }
+  }
 }
 
 cv::Mat FullRateEmission::operator()(const cv::Mat& linear) const {
@@ -65,7 +74,7 @@ cv::Mat FullRateEmission::operator()(const cv::Mat& linear) const {
     double* dst = out.ptr<double>(y);
     if (oled_codes_) {
       if (oled_codes_->codes(std::span<const double>(src, samples), codes)) {
-        emission_.row(codes, std::span<double>(dst, samples));
+        for (std::size_t k = 0; k < samples; ++k) dst[k] = held_light_[k % 3][codes[k]];
       } else {
         for (std::size_t k = 0; k < samples; ++k) dst[k] = per_sample(src[k], static_cast<int>(k % 3));
       }
@@ -78,8 +87,7 @@ cv::Mat FullRateEmission::operator()(const cv::Mat& linear) const {
         dst[k] = per_sample(src[k], c);
         continue;
       }
-      const std::uint16_t code = quantise(v, top_);  // floor(clamp(v) top + 1/2), held: the previous code is this one
-      dst[k] = emission_(code, code, c);
+      dst[k] = held_light_[static_cast<std::size_t>(c)][quantise(v, top_)];  // quantise: floor(clamp(v) top + 1/2)
     }
   }
   return out;

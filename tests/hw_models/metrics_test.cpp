@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -83,45 +84,55 @@ TEST(FullRateEmission, IsTheLightOfTheNearestDriveCode) {
   }
 }
 
-// The tables' form against the per-sample one, bit for bit: every code's crossing and the doubles either side of it,
-// random values, the ends, values outside [0, 1] and NaN, OLED and LCD panels at 8 and 10 bits.
+// The tables' form against the per-sample one, bit for bit, OLED and LCD panels at 8 and 10 bits: a row of values
+// near every code's crossing (within and just past OledDriveCodes' guard of 256 ulps, where its lookup and its pow
+// meet) and random ones, which an OLED takes through its tables; and a row with NaN, infinities and values outside
+// [0, 1], which an OLED takes per sample (a NaN anywhere in a row does).
 TEST(FullRateEmission, TheTablesGiveThePerSampleDoubles) {
+  const auto ulps_away = [](double x, std::int64_t n) {
+    return std::bit_cast<double>(static_cast<std::int64_t>(std::bit_cast<std::uint64_t>(x)) + n);
+  };
   for (const std::string spec : {"vive", "rift", "gamma:0.5,2.2,4", "lcd", "lcd:0.3,0.1,0.3,0,2.4"}) {
     const Panel panel = parse_panel(spec);
     for (const int bits : {8, 10}) {
       const int top = (1 << bits) - 1;
-      std::vector<double> values;
+      std::vector<double> near_crossings;
       for (int c = 0; c < 3; ++c) {
-        for (int k = 0; k <= top; ++k) {
-          // The linear value whose drive is half a code below k (a crossing), and its neighbours.
-          const double crossing = panel.linear_from_drive(std::max(0.0, (k - 0.5) / top), c);
-          for (double x = std::nextafter(std::nextafter(crossing, 0.0), 0.0), i = 0; i < 5; ++i, x = std::nextafter(x, 2.0)) {
-            while (values.size() % 3 != static_cast<std::size_t>(c)) values.push_back(0.5);
-            values.push_back(x);
+        for (int k = 1; k <= top; ++k) {
+          // The linear value whose drive is half a code below k: where code k begins, give or take the pow's error.
+          const double crossing = panel.linear_from_drive((k - 0.5) / top, c);
+          for (const std::int64_t n : {-300, -257, -256, -255, -2, -1, 0, 1, 2, 255, 256, 257, 300}) {
+            while (near_crossings.size() % 3 != static_cast<std::size_t>(c)) near_crossings.push_back(0.5);
+            near_crossings.push_back(ulps_away(crossing, n));
           }
         }
       }
       std::mt19937_64 random(7);
       std::uniform_real_distribution<double> unit(0.0, 1.0);
-      for (int i = 0; i < 3000; ++i) values.push_back(unit(random));
-      for (const double x : {0.0, -0.0, 1.0, -1e-300, 1.5, -2.0, std::numeric_limits<double>::quiet_NaN(),
-                             std::numeric_limits<double>::infinity(), 5e-324}) {
-        values.push_back(x);
-      }
-      while (values.size() % 3 != 0) values.push_back(0.25);
-      const cv::Mat linear = cv::Mat(values, true).reshape(3, 1);
-      const cv::Mat expected = full_rate_emission(linear, panel, bits);
-      const cv::Mat tables = FullRateEmission(panel, bits)(linear);
-      ASSERT_EQ(tables.type(), CV_64FC3);
-      ASSERT_EQ(tables.size(), expected.size());
-      const double* a = expected.ptr<double>(0);
-      const double* b = tables.ptr<double>(0);
-      for (std::size_t k = 0; k < values.size(); ++k) {
-        ASSERT_TRUE(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))
-            << spec << " " << bits << "-bit sample " << k << " x = " << values[k] << ": " << a[k] << " against " << b[k];
+      for (int i = 0; i < 3000; ++i) near_crossings.push_back(unit(random));
+      for (const double x : {0.0, -0.0, 1.0, 5e-324}) near_crossings.push_back(x);
+      std::vector<double> edges = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                                   -std::numeric_limits<double>::infinity(), -1e-300, 1.5, -2.0, 0.5, 0.25, 1e-3};
+      const FullRateEmission tables(panel, bits);
+      for (std::vector<double>* values : {&near_crossings, &edges}) {
+        while (values->size() % 3 != 0) values->push_back(0.25);
+        const cv::Mat linear = cv::Mat(*values, true).reshape(3, 1);
+        const cv::Mat expected = full_rate_emission(linear, panel, bits);
+        const cv::Mat got = tables(linear);
+        ASSERT_EQ(got.type(), CV_64FC3);
+        ASSERT_EQ(got.size(), expected.size());
+        const double* a = expected.ptr<double>(0);
+        const double* b = got.ptr<double>(0);
+        for (std::size_t k = 0; k < values->size(); ++k) {
+          ASSERT_TRUE(a[k] == b[k] || (std::isnan(a[k]) && std::isnan(b[k])))
+              << spec << " " << bits << "-bit sample " << k << " x = " << (*values)[k] << ": " << a[k] << " against "
+              << b[k];
+        }
       }
     }
   }
+  EXPECT_THROW(FullRateEmission(parse_panel("vive"), 0), std::invalid_argument);
+  EXPECT_THROW(FullRateEmission(parse_panel("lcd"), 17), std::invalid_argument);
 }
 
 TEST(CodeAgreement, CountsIdenticalCodesOfEveryChannel) {

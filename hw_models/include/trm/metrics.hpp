@@ -8,9 +8,11 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <vector>
 
 namespace trm {
 
@@ -29,8 +31,9 @@ cv::Mat perceived_pair(const Panel& panel, const cv::Mat& emitted_previous, cons
 cv::Mat full_rate_emission(const cv::Mat& linear, const Panel& panel, int output_bits);
 
 // full_rate_emission of one panel and output depth with its tables built once, the same doubles: an OLED's codes from
-// where each code begins (OledDriveCodes) instead of a pow per sample, and every code's light from PanelEmission (an
-// LCD's as held: M(v, v)^gamma) instead of a second one. For a report that takes the reference of every view.
+// where each code begins (OledDriveCodes) instead of a pow per sample, and the light of every code held
+// (Panel::linear_from_drive of code / (2^bits - 1), per channel) instead of a second one. For a report that takes the
+// reference of every view. output_bits in [1, 16] (else std::invalid_argument).
 class FullRateEmission {
  public:
   FullRateEmission(const Panel& panel, int output_bits);
@@ -40,7 +43,7 @@ class FullRateEmission {
   Panel panel_;
   int top_;
   std::optional<OledDriveCodes> oled_codes_;  // an OLED's
-  PanelEmission emission_;
+  std::array<std::vector<double>, 3> held_light_;  // [channel][code]
 };
 
 // Frame pairs as the eye sees them at a fixed gaze, per eye. Views come in slot order with their emitted light and
