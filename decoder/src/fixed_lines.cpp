@@ -693,9 +693,7 @@ void DriveValuesOf(const Linear* linear, std::size_t n, const DriveValuePlan& p,
   (void)p;
 #else
   const hn::ScalableTag<std::int64_t> d;
-  const hn::RebindToUnsigned<decltype(d)> du;
   const hn::Rebind<std::int32_t, decltype(d)> d32;
-  const hn::Rebind<double, decltype(d)> df;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
   const auto one = hn::Set(d, p.one);
@@ -1282,17 +1280,14 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
   const hn::Rebind<std::uint32_t, decltype(du)> du32h;
   const hn::Rebind<std::uint16_t, decltype(du)> d16;
   const hn::Rebind<std::uint8_t, decltype(du)> d8;
-  const hn::Rebind<double, decltype(d)> df;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
-  const auto unit = hn::Set(d, std::int64_t{1});
   const auto one = hn::Set(d, p.one);
   const auto full_sum = hn::Set(d, std::int64_t{1} << (p.linear_frac_bits + 1));
   const auto bottom_bits = hn::Set(d, std::int64_t{p.bottom_region_bits});
   const auto scale = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.scale}));
   const auto top = hn::Set(d, std::int64_t{p.top});
   const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
-  const auto exponent_bias = hn::Set(d, std::int64_t{1023});
   auto unreachable_lanes = zero;
   const auto held_row = hn::Set(d, p.width);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
   // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
