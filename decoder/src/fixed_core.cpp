@@ -397,30 +397,6 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
   if (whole_line) emit_line(out, eye, y, shown, nullptr);
 }
 
-namespace {
-
-// The drive codes of output line y by the OLED or the LCD drive kernel, from a line of either width; false where
-// neither runs (lcd_kernel: FixedDecoderCore::lcd_drive_kernel).
-template <typename Linear>
-bool drive_line(const FixedKernels& kernels, bool lcd_kernel, FrameOutput& out, EyeState& eye, int y,
-                const Linear* shown, Raw* shortfall) {
-  const auto n = 3 * static_cast<std::size_t>(eye.full_size.width);
-  const FixedLinePlans& plans = kernels.line_plans();
-  if (plans.drive) {
-    lines::drive_codes(shown, n, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
-    if (shortfall != nullptr) std::fill_n(shortfall, n, Raw{0});
-    return true;
-  }
-  if (!lcd_kernel) return false;
-  out.tally.counts.lcd_unreachable += lines::lcd_drive(
-      shown, n, *plans.lcd, kernels, eye.lcd_previous_drive.ptr<std::uint8_t>(y),
-      eye.lcd_previous_linear.ptr<std::int32_t>(y), out.lcd_held, out.frame.drive_codes.ptr<std::uint16_t>(y),
-      shortfall);
-  return true;
-}
-
-}  // namespace
-
 template <typename Linear>
 void FixedDecoderCore::report_line(FrameOutput& out, int y, const Linear* shown) const {
   const std::uint16_t* codes = out.frame.drive_codes.ptr<std::uint16_t>(y);
@@ -437,7 +413,9 @@ void FixedDecoderCore::report_line(FrameOutput& out, int y, const Linear* shown)
     if (plan) {
       lines::drive_values(shown + start, count, *plan, kernels_, drive_raw.data());
     } else {
-      for (std::size_t i = 0; i < count; ++i) drive_raw[i] = kernels_.drive_value(shown[start + i], static_cast<int>(i % 3));
+      for (std::size_t i = 0; i < count; ++i) {
+        drive_raw[i] = kernels_.drive_value(shown[start + i], static_cast<int>(i % 3));
+      }
     }
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t k = start + i;
@@ -449,18 +427,69 @@ void FixedDecoderCore::report_line(FrameOutput& out, int y, const Linear* shown)
   }
 }
 
+template <typename Linear>
+void FixedDecoderCore::drive_lcd_line(FrameOutput& out, EyeState& eye, int y, const Linear* shown,
+                                      Raw* shortfall) const {
+  const auto samples = 3 * static_cast<std::size_t>(eye.full_size.width);
+  const LcdPlan& plan = *kernels_.line_plans().lcd;
+  std::uint8_t* previous_code = eye.lcd_previous_drive.ptr<std::uint8_t>(y);
+  std::int32_t* previous_linear = eye.lcd_previous_linear.ptr<std::int32_t>(y);
+  std::uint16_t* codes = out.frame.drive_codes.ptr<std::uint16_t>(y);
+  if (!config().decoder.report_planes) {
+    out.tally.counts.lcd_unreachable += lines::lcd_drive(shown, samples, plan, kernels_, previous_code,
+                                                         previous_linear, out.lcd_held, codes, shortfall);
+    return;
+  }
+  // The planes' drive value and light read v_{t-1} and x_{t-1}, which the kernel replaces in the frame stores: a
+  // chunk of whole pixels at a time, its stored values kept.
+  double* wanted = out.frame.wanted_linear.ptr<double>(y);
+  double* drive = out.frame.drive.ptr<double>(y);
+  double* emitted = out.frame.emitted_linear.ptr<double>(y);
+  constexpr std::size_t kChunk = 3 * 128;
+  std::array<std::uint8_t, kChunk> code_before;
+  std::array<std::int32_t, kChunk> linear_before;
+  std::array<Raw, kChunk> drive_raw;
+  std::array<std::uint16_t, kChunk> solved_against;  // v_{t-1} of each sample's merge (the held code on the first frame)
+  for (std::size_t start = 0; start < samples; start += kChunk) {
+    const std::size_t count = std::min(kChunk, samples - start);
+    std::copy_n(previous_code + start, count, code_before.data());
+    std::copy_n(previous_linear + start, count, linear_before.data());
+    out.tally.counts.lcd_unreachable +=
+        lines::lcd_drive(shown + start, count, plan, kernels_, previous_code + start, previous_linear + start,
+                         out.lcd_held, codes + start, shortfall != nullptr ? shortfall + start : nullptr);
+    kernels_.lcd_reports(shown + start, linear_before.data(), code_before.data(), codes + start, count,
+                         out.lcd_held, drive_raw.data(), solved_against.data());
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t k = start + i;
+      wanted[k] = kernels_.linear_to_double(shown[k]);
+      drive[k] = kernels_.drive_to_double(drive_raw[i]);
+      emitted[k] = kernels_.emitted(codes[k], solved_against[i], static_cast<int>(i % 3));
+    }
+  }
+}
+
+template <typename Linear>
+bool FixedDecoderCore::drive_line(FrameOutput& out, EyeState& eye, int y, const Linear* shown, Raw* shortfall) const {
+  const FixedLinePlans& plans = kernels_.line_plans();
+  if (plans.drive) {
+    const auto samples = 3 * static_cast<std::size_t>(eye.full_size.width);
+    lines::drive_codes(shown, samples, *plans.drive, out.frame.drive_codes.ptr<std::uint16_t>(y));
+    if (shortfall != nullptr) std::fill_n(shortfall, samples, Raw{0});
+    if (config().decoder.report_planes) report_line(out, y, shown);
+    return true;
+  }
+  if (!plans.lcd) return false;
+  drive_lcd_line(out, eye, y, shown, shortfall);
+  return true;
+}
+
 void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const std::int32_t* shown,
                                  Raw* shortfall) const {
-  drive_line(kernels_, lcd_drive_kernel(), out, eye, y, shown, shortfall);  // narrow_lines: one of the kernels runs
-  if (config().decoder.report_planes) report_line(out, y, shown);
+  drive_line(out, eye, y, shown, shortfall);  // narrow_lines: one of the kernels runs
 }
 
 void FixedDecoderCore::emit_line(FrameOutput& out, EyeState& eye, int y, const Raw* shown, Raw* shortfall) const {
-  if (drive_line(kernels_, lcd_drive_kernel(), out, eye, y, shown, shortfall)) {
-    // Only the OLED's kernel runs with report planes (lcd_drive_kernel).
-    if (config().decoder.report_planes) report_line(out, y, shown);
-    return;
-  }
+  if (drive_line(out, eye, y, shown, shortfall)) return;
   for (int x = 0; x < eye.full_size.width; ++x) {
     for (int ch = 0; ch < 3; ++ch) {
       const Raw missing = emit(out, eye, y, x, ch, shown[3 * x + ch]);

@@ -332,12 +332,7 @@ class FixedDecoderCore {
   bool narrow_lines(const FrameOutput& out) const {
     const FixedLinePlans& plans = kernels_.line_plans();
     if (!line_values(out) || plans.code_rom32.empty()) return false;
-    return plans.drive ? !plans.drive->base32.empty() : lcd_drive_kernel();
-  }
-  // The LCD drive kernel runs where no report planes are wanted: with them, emit drives each sample in raster order
-  // (its drive value and the light after the previous code are the planes' samples).
-  bool lcd_drive_kernel() const {
-    return kernels_.line_plans().lcd.has_value() && !config().decoder.report_planes;
+    return plans.drive ? !plans.drive->base32.empty() : plans.lcd.has_value();
   }
   // A line's codes may come without its shown values (U's nodes' codes, FixedLinePlans::drive_of_node): where no
   // report plane wants those values.
@@ -354,6 +349,14 @@ class FixedDecoderCore {
   // drive codes the OLED drive kernel wrote: the samples emit gives them.
   template <typename Linear>
   void report_line(FrameOutput& out, int y, const Linear* shown) const;
+  // Output line y through the LCD drive kernel (its codes, frame stores and shortfall where not null), and with
+  // report planes their samples as emit gives them, from the stores' v_{t-1} and x_{t-1} before the kernel.
+  template <typename Linear>
+  void drive_lcd_line(FrameOutput& out, EyeState& eye, int y, const Linear* shown, Raw* shortfall) const;
+  // The drive codes of output line y by the OLED or the LCD drive kernel, with the report planes where wanted; false
+  // where neither kernel runs.
+  template <typename Linear>
+  bool drive_line(FrameOutput& out, EyeState& eye, int y, const Linear* shown, Raw* shortfall) const;
   // The drive codes of a line's shown values: the OLED drive kernel, the LCD drive kernel, else emit per sample in
   // raster order (the LCD's frame stores). shortfall, where not null, receives each sample's LCD shortfall (0 on an
   // OLED), which a full frame adds to rho (Sec. 4.4).

@@ -207,6 +207,15 @@ class FixedKernels {
   // also the report drive value v (else LcdSample::drive stays 0).
   LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
                       bool drive_value = true) const;
+  // The same sample's report where its code is known (the LCD drive kernel's): lcd_drive's v_{t-1} and drive value
+  // without the search.
+  LcdSample lcd_report(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
+                       std::uint16_t code) const;
+  // lcd_report of the n samples of a line whose codes the LCD drive kernel gave: drive[s] and previous[s] are
+  // lcd_report(wanted[s], previous_wanted[s], previous_code[s], held, codes[s])'s drive and previous_code.
+  template <typename Linear>
+  void lcd_reports(const Linear* wanted, const std::int32_t* previous_wanted, const std::uint8_t* previous_code,
+                   const std::uint16_t* codes, std::size_t n, bool held, Raw* drive, std::uint16_t* previous) const;
   // lcd_drive's search: the largest k in [0, top] with merge_at(k) <= target_scaled (merge_at(k) = M(T_k, v_{t-1})
   // scaled, increasing in k; k = 0 is not read), by binary comparison.
   template <typename MergeAt>
@@ -310,6 +319,7 @@ class FixedKernels {
   std::array<Raw, 4> lcd_coefficients_{};       // p1..p4
   std::array<Raw, 4> lcd_held_coefficients_{};  // M(v, v): 2 p1 + p2, 0, 2 p3, p4
   std::unique_ptr<fx::InterpolatedLut> lcd_target_lut_;
+  int lcd_target_shift_ = 0;  // the sum's bits below the target LUT's input
   // scaled_merge(p, 2k - 1, j) for every code k >= 1 and v_{t-1} = j (rows 0..2^o - 1), then the held row
   // (lcd_held_coefficients_, j = 0); empty above kLcdMergeTableMaxCode.
   static constexpr int kLcdMergeTableMaxCode = 255;
@@ -320,6 +330,41 @@ class FixedKernels {
   // c = difference / sum through the reciprocal LUT, clamped to 1; difference > 0.
   Raw contrast_of(Raw difference, Raw sum) const;
   Raw lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled, int code, Raw j) const;
+  // lcd_drive and lcd_report: the code searched for, or the one given.
+  LcdSample lcd_solve(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
+                      std::optional<std::uint16_t> code, bool drive_value) const;
+  // lcd_solve's steps. The target m = ((x_t + x_{t-1}) / 2)^(1/gamma) of sum = x_t + x_{t-1} (the average in
+  // uQ1.(F+1); the LUT takes its top bits), scaled as scaled_merge: m (2 Mx)^2 2^F.
+  Raw lcd_target_scaled(Raw sum) const {
+    const int F = config_.linear_frac_bits;
+    const Raw two_top = 2 * static_cast<Raw>(max_output_code());
+    Raw target = 0;
+    if (sum >= (Raw{1} << (F + 1))) {
+      target = one();
+    } else if (sum > 0) {
+      target = lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> lcd_target_shift_));
+    }
+    return target * (two_top * two_top);
+  }
+  // Reachability is decided in linear light, on the sum x_t + x_{t-1} against 2 M(0|1, v_{t-1} = j)^gamma from the
+  // same ROMs the shortfall uses: 0 where the sum lies below the dark end, 1 above the bright end, -1 between them.
+  // The exact ends of the range are met exactly: white after white (the ROM holds 1.0), black after black, and with
+  // LcdHistory::Contributed the next target, which is built from the ROM value itself. (In m, the 1/gamma power and
+  // the quantised coefficients would blur these ends by many LSB near black.)
+  int lcd_clamped_end(Raw sum, Raw j) const {
+    const auto row = static_cast<std::size_t>(j);
+    if (sum < 2 * lcd_end_luminance_[0][row]) return 0;
+    return sum > 2 * lcd_end_luminance_[1][row] ? 1 : -1;
+  }
+  // The drive value of a clamped (unreachable) sample: 0 or 1.
+  Raw lcd_clamped_drive(bool above) const { return above ? Raw{1} << config_.drive_frac_bits : 0; }
+  // The largest code k whose threshold merge with v_{t-1} = j (coefficients p; row: lcd_merge_table_'s row, or null:
+  // computed per step) is at or below target_scaled.
+  Raw lcd_search(const std::array<Raw, 4>& p, Raw j, Raw target_scaled, const Raw* row) const;
+  // v_{t-1} of the eye's first frame: the code whose held merge M(v, v) reaches the target.
+  Raw lcd_held_code(Raw target_scaled) const;
+  // lcd_merge_table_'s row (v_{t-1} = row; row 2^o: the held merge), or null where the table is not built.
+  const Raw* lcd_merge_row(std::size_t row) const;
   Raw blend_linear(Raw top_left, Raw top_right, Raw bottom_left, Raw bottom_right, Raw col_upper, Raw row_upper) const;
   StoredResidual store_nonzero_residual(Raw rho) const;
 };

@@ -104,6 +104,7 @@ FixedKernels::FixedKernels(const FixedDecoderConfig& config) : config_(config) {
     target_shape.output_bits = 1 + F;
     target_shape.output_frac_bits = F;
     lcd_target_lut_ = std::make_unique<fx::InterpolatedLut>(fx::make_inverse_gamma_lut(lcd.gamma, target_shape));
+    lcd_target_shift_ = F + 1 - address_bits;
     const fx::RuntimeFormat luminance{4, F, true, fx::Quant::Rnd, fx::Overflow::Sat};
     for (int end = 0; end < 2; ++end) {
       std::vector<Raw>& rom = lcd_end_luminance_[static_cast<std::size_t>(end)];

@@ -168,55 +168,87 @@ Raw FixedKernels::lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled
 
 LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
                                    bool drive_value) const {
-  const int F = config_.linear_frac_bits;
+  return lcd_solve(wanted, previous_wanted, previous_code, held, std::nullopt, drive_value);
+}
+
+LcdSample FixedKernels::lcd_report(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
+                                   std::uint16_t code) const {
+  return lcd_solve(wanted, previous_wanted, previous_code, held, code, true);
+}
+
+LcdSample FixedKernels::lcd_solve(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
+                                  std::optional<std::uint16_t> code, bool drive_value) const {
   const int top = max_output_code();
-  const Raw two_top = 2 * static_cast<Raw>(top);
   LcdSample out;
-  // m = ((x_t + x_{t-1}) / 2)^(1/gamma): the sum is the average in uQ1.(F+1); the LUT takes its top 24 bits.
   const Raw sum = held ? 2 * wanted : wanted + previous_wanted;
-  Raw target = 0;
-  if (sum >= (Raw{1} << (F + 1))) {
-    target = one();
-  } else if (sum > 0) {
-    const int shift = F + 1 - lcd_target_lut_->shape().input_bits;
-    target = lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> shift));
-  }
-  const Raw target_scaled = target * (two_top * two_top);  // m (2 Mx)^2 2^F, as scaled_merge
-  // row: the threshold merges of this v_{t-1} from lcd_merge_table_ (null: computed per step).
-  const auto search = [&](const std::array<Raw, 4>& p, Raw j, const Raw* row) {
-    return merge_search(top, target_scaled, [&](int k) {  // M(T_k, vp) increases with T
-      return row != nullptr ? row[k] : scaled_merge(p, 2 * static_cast<Raw>(k) - 1, j);
-    });
-  };
-  const std::size_t width = static_cast<std::size_t>(top) + 1;
-  const auto table_row = [&](std::size_t row) {
-    return lcd_merge_table_.empty() ? nullptr : lcd_merge_table_.data() + row * width;
-  };
+  const Raw target_scaled = lcd_target_scaled(sum);
   // First frame of the eye: the pixel is taken as held at x_t (M(v, v) = x_t^(1/gamma), the same m).
-  const Raw j = held ? search(lcd_held_coefficients_, 0, table_row(width)) : previous_code;
+  const Raw j = held ? lcd_held_code(target_scaled) : previous_code;
   const Raw x_previous = held ? wanted : previous_wanted;
   out.previous_code = static_cast<std::uint16_t>(j);
   out.contributed = wanted;
-  // Reachability is decided in linear light, on the sum x_t + x_{t-1} against 2 M(0|1, v_{t-1})^gamma from the same
-  // ROMs the shortfall uses. The exact ends of the range are met exactly: white after white (the ROM holds 1.0),
-  // black after black, and with LcdHistory::Contributed the next target, which is built from the ROM value itself.
-  // (In m, the 1/gamma power and the quantised coefficients would blur these ends by many LSB near black.)
-  const bool below = sum < 2 * lcd_end_luminance_[0][static_cast<std::size_t>(j)];
-  const bool above = sum > 2 * lcd_end_luminance_[1][static_cast<std::size_t>(j)];
-  if (below || above) {
+  const int end = lcd_clamped_end(sum, j);
+  if (end >= 0) {
     // No root in [0, 1]: v clamps to the nearer end; frame t contributes x_eff = 2 M(v, v_prev)^gamma - x_{t-1}.
+    const bool above = end == 1;
     out.unreachable = true;
     out.code = static_cast<std::uint16_t>(above ? top : 0);
-    out.drive = above ? Raw{1} << config_.drive_frac_bits : 0;
-    const Raw x_effective = 2 * lcd_end_luminance_[above ? 1 : 0][static_cast<std::size_t>(j)] - x_previous;
+    out.drive = lcd_clamped_drive(above);
+    const Raw x_effective = 2 * lcd_end_luminance_[static_cast<std::size_t>(end)][static_cast<std::size_t>(j)] -
+                            x_previous;
     out.shortfall = wanted - x_effective;
     out.contributed = x_effective;
     return out;
   }
-  out.code = static_cast<std::uint16_t>(search(lcd_coefficients_, j, table_row(static_cast<std::size_t>(j))));
+  out.code = code ? *code
+                  : static_cast<std::uint16_t>(lcd_search(lcd_coefficients_, j, target_scaled,
+                                                          lcd_merge_row(static_cast<std::size_t>(j))));
   if (drive_value) out.drive = lcd_drive_value(lcd_coefficients_, target_scaled, out.code, j);
   return out;
 }
+
+Raw FixedKernels::lcd_search(const std::array<Raw, 4>& p, Raw j, Raw target_scaled, const Raw* row) const {
+  return merge_search(max_output_code(), target_scaled, [&](int k) {  // M(T_k, vp) increases with T
+    return row != nullptr ? row[k] : scaled_merge(p, 2 * static_cast<Raw>(k) - 1, j);
+  });
+}
+
+Raw FixedKernels::lcd_held_code(Raw target_scaled) const {
+  const auto held_row = static_cast<std::size_t>(max_output_code()) + 1;
+  return lcd_search(lcd_held_coefficients_, 0, target_scaled, lcd_merge_row(held_row));
+}
+
+const Raw* FixedKernels::lcd_merge_row(std::size_t row) const {
+  const std::size_t width = static_cast<std::size_t>(max_output_code()) + 1;
+  return lcd_merge_table_.empty() ? nullptr : lcd_merge_table_.data() + row * width;
+}
+
+template <typename Linear>
+void FixedKernels::lcd_reports(const Linear* wanted, const std::int32_t* previous_wanted,
+                               const std::uint8_t* previous_code, const std::uint16_t* codes, std::size_t n, bool held,
+                               Raw* drive, std::uint16_t* previous) const {
+  if (held) {
+    for (std::size_t s = 0; s < n; ++s) {
+      const LcdSample sample = lcd_report(wanted[s], previous_wanted[s], previous_code[s], true, codes[s]);
+      drive[s] = sample.drive;
+      previous[s] = sample.previous_code;
+    }
+    return;
+  }
+  for (std::size_t s = 0; s < n; ++s) {  // lcd_solve's steps past the held frame, the code given
+    const Raw sum = Raw{wanted[s]} + previous_wanted[s];
+    const Raw j = previous_code[s];
+    const int end = lcd_clamped_end(sum, j);
+    drive[s] = end >= 0 ? lcd_clamped_drive(end == 1)
+                        : lcd_drive_value(lcd_coefficients_, lcd_target_scaled(sum), codes[s], j);
+    previous[s] = previous_code[s];
+  }
+}
+
+template void FixedKernels::lcd_reports(const std::int32_t*, const std::int32_t*, const std::uint8_t*,
+                                        const std::uint16_t*, std::size_t, bool, Raw*, std::uint16_t*) const;
+template void FixedKernels::lcd_reports(const Raw*, const std::int32_t*, const std::uint8_t*, const std::uint16_t*,
+                                        std::size_t, bool, Raw*, std::uint16_t*) const;
 
 Raw FixedKernels::luma(const Raw* rgb) const {
   const Raw sum = luma_weights_[0] * rgb[0] + luma_weights_[1] * rgb[1] + luma_weights_[2] * rgb[2];
