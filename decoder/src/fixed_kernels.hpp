@@ -207,6 +207,12 @@ class FixedKernels {
   // also the report drive value v (else LcdSample::drive stays 0).
   LcdSample lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
                       bool drive_value = true) const;
+  // The LCD drive's target m = ((x_t + x_{t-1}) / 2)^(1/gamma) of sum = x_t + x_{t-1} (the average in uQ1.(F+1); the
+  // LUT takes its top bits), uQ1.F.
+  Raw lcd_target(Raw sum) const {
+    if (sum >= (Raw{1} << (config_.linear_frac_bits + 1))) return one();
+    return sum > 0 ? lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> lcd_target_shift_)) : 0;
+  }
   // The same sample's report where its code is known (the LCD drive kernel's): lcd_drive's v_{t-1} and drive value
   // without the search.
   LcdSample lcd_report(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
@@ -333,17 +339,10 @@ class FixedKernels {
   // lcd_drive and lcd_report: the code searched for, or the one given.
   LcdSample lcd_solve(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
                       std::optional<std::uint16_t> code, bool drive_value) const;
-  // lcd_solve's steps. The target m = ((x_t + x_{t-1}) / 2)^(1/gamma) of sum = x_t + x_{t-1} (the average in
-  // uQ1.(F+1); the LUT takes its top bits), scaled as scaled_merge: m (2 Mx)^2 2^F.
-  Raw lcd_target_scaled(Raw sum) const {
-    const int F = config_.linear_frac_bits;
+  // lcd_solve's steps. The target m = ((x_t + x_{t-1}) / 2)^(1/gamma) scaled as scaled_merge: m (2 Mx)^2 2^F.
+  Raw lcd_target_scaled(Raw sum) const { return scale_lcd_target(lcd_target(sum)); }
+  Raw scale_lcd_target(Raw target) const {
     const Raw two_top = 2 * static_cast<Raw>(max_output_code());
-    Raw target = 0;
-    if (sum >= (Raw{1} << (F + 1))) {
-      target = one();
-    } else if (sum > 0) {
-      target = lcd_target_lut_->evaluate_raw(static_cast<std::uint32_t>(sum >> lcd_target_shift_));
-    }
     return target * (two_top * two_top);
   }
   // Reachability is decided in linear light, on the sum x_t + x_{t-1} against 2 M(0|1, v_{t-1} = j)^gamma from the

@@ -1120,6 +1120,54 @@ void LcdSearch(const std::int64_t* target, const std::int64_t* rows, std::size_t
   }
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// m = ((x_t + x_{t-1}) / 2)^(1/gamma) of sums in 64-bit lanes through the plan's octave ROM (FixedKernels::
+// lcd_target): the region by the ROM input's leading one, the node and the weight, then the node's word
+// interpolated. (A sum of 2 or more reads 1, not the ROM: its input is clamped as evaluate_raw clamps it.)
+template <class D>
+struct LcdTargetRom {
+  LcdTargetRom(D d, const LcdPlan& p)
+      : zero(hn::Zero(d)),
+        one(hn::Set(d, p.one)),
+        full_sum(hn::Set(d, std::int64_t{1} << (p.linear_frac_bits + 1))),
+        bottom_bits(hn::Set(d, std::int64_t{p.bottom_region_bits})),
+        top_input(hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1)),
+        shift(p.target_shift),
+        segments_log2(p.segments_per_octave_log2),
+        packed(p.target_packed.data()) {}
+  OctavePlace<D> place(D d, hn::Vec<D> sum) const {
+    const auto input = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), shift), top_input);
+    return OctaveRomPlace(d, input, bottom_bits, segments_log2);
+  }
+  // The target from the place's ROM word.
+  hn::Vec<D> from(D d, hn::Vec<D> sum, hn::Vec<D> word, hn::Vec<D> weight, hn::Vec<D> scale_bits) const {
+    const auto rom_target = InterpolateWord(d, word, weight, scale_bits);
+    return hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
+  }
+  hn::Vec<D> operator()(D d, hn::Vec<D> sum) const {
+    const OctavePlace<D> at = place(d, sum);
+    return from(d, sum, LookupWords(d, packed, at.node), at.weight, at.scale_bits);
+  }
+  hn::Vec<D> zero, one, full_sum, bottom_bits, top_input;
+  int shift;
+  int segments_log2;
+  const std::int64_t* packed;
+};
+#endif
+
+void LcdTargets(const std::int64_t* sum, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                std::int64_t* target) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<std::int64_t> d;
+  const LcdTargetRom<std::remove_const_t<decltype(d)>> rom(d, p);
+  for (; s + hn::Lanes(d) <= n; s += hn::Lanes(d)) hn::StoreU(rom(d, hn::LoadU(d, sum + s)), d, target + s);
+#else
+  (void)p;
+#endif
+  for (; s < n; ++s) target[s] = kernels.lcd_target(sum[s]);
+}
+
 // One sample of the LCD drive by the stage function, with emit's frame-store update.
 inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const FixedKernels& kernels,
                                 std::uint8_t& previous_code, std::int32_t& previous_linear, bool held,
@@ -1282,17 +1330,11 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
   const hn::Rebind<std::uint8_t, decltype(du)> d8;
   const std::size_t lanes = hn::Lanes(d);
   const auto zero = hn::Zero(d);
-  const auto one = hn::Set(d, p.one);
-  const auto full_sum = hn::Set(d, std::int64_t{1} << (p.linear_frac_bits + 1));
-  const auto bottom_bits = hn::Set(d, std::int64_t{p.bottom_region_bits});
   const auto scale = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.scale}));
   const auto top = hn::Set(d, std::int64_t{p.top});
-  const auto top_code = hn::Set(d, (std::int64_t{1} << p.target_input_bits) - 1);
   auto unreachable_lanes = zero;
   const auto held_row = hn::Set(d, p.width);  // M(v, v)'s row, after the 2^o rows of v_{t-1}
   // The plan's fields in locals: the compiler reloads whatever a vector store could alias.
-  const int target_shift = p.target_shift;
-  const int segments_log2 = p.segments_per_octave_log2;
   const std::int64_t* target_packed = p.target_packed.data();
   const std::int64_t* ends = p.ends.data();
   const bool contributed_stored = p.contributed;
@@ -1313,22 +1355,7 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
   const auto previous_row = [&](std::size_t i) {
     return hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d8, previous_code + i))));
   };
-  // m through the octave ROM (InterpolatedLut::evaluate_raw): the region by the code's leading one, the node and the
-  // weight, then the node's word interpolated. (A sum of 2 or more reads 1, not the ROM: its code is clamped as
-  // evaluate_raw clamps it.)
-  using RomPlace = OctavePlace<std::remove_const_t<decltype(d)>>;
-  const auto target_place = [&](const auto sum) {
-    const auto code = hn::Min(hn::ShiftRightSame(hn::Max(sum, zero), target_shift), top_code);
-    return OctaveRomPlace(d, code, bottom_bits, segments_log2);
-  };
-  const auto target_from = [&](const auto sum, const auto word, const auto weight, const auto scale_bits) {
-    const auto rom_target = InterpolateWord(d, word, weight, scale_bits);
-    return hn::IfThenElse(hn::Lt(sum, full_sum), hn::IfThenElseZero(hn::Gt(sum, zero), rom_target), one);
-  };
-  const auto target_of = [&](const auto sum) {
-    const RomPlace place = target_place(sum);
-    return target_from(sum, LookupWords(d, target_packed, place.node), place.weight, place.scale_bits);
-  };
+  const LcdTargetRom<std::remove_const_t<decltype(d)>> target_rom(d, p);
   // Given v_{t-1} = j and lo, the largest k with M(T_k, v_{t-1}) <= m: the unreachable ends, the codes and the
   // frame stores.
   const auto finish = [&](std::size_t i, const auto x, const auto x_previous, const auto sum, const auto j,
@@ -1351,7 +1378,7 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
       const auto x = load_wanted(s);
       const auto x_previous = previous_of(s, x);
       const auto sum = hn::Add(x, x_previous);
-      const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target_of(sum)), scale));
+      const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, target_rom(d, sum)), scale));
       const auto search = [&](const auto row) {
         return LcdBinarySearch(d, p, target_scaled, hn::ShiftLeftSame(row, p.width_log2));
       };
@@ -1371,7 +1398,7 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
       const std::size_t m = pass_chunk(n - s, lanes);
       for (std::size_t i = 0; i < m; i += lanes) {  // m's ROM places, then its words
         const auto x = load_wanted(s + i);
-        const RomPlace place = target_place(hn::Add(x, previous_of(s + i, x)));
+        const auto place = target_rom.place(d, hn::Add(x, previous_of(s + i, x)));
         hn::Store(place.node, d, targets + i);
         hn::Store(place.weight, d, rom_weights + i);
         hn::Store(place.scale_bits, d, rom_shifts + i);
@@ -1379,8 +1406,8 @@ std::uint64_t LcdDriveOf(const Wanted* wanted, std::size_t n, const LcdPlan& p, 
       look_up(target_packed, targets, m);
       for (std::size_t i = 0; i < m; i += lanes) {
         const auto x = load_wanted(s + i);
-        const auto target = target_from(hn::Add(x, previous_of(s + i, x)), hn::Load(d, targets + i),
-                                        hn::Load(d, rom_weights + i), hn::Load(d, rom_shifts + i));
+        const auto target = target_rom.from(d, hn::Add(x, previous_of(s + i, x)), hn::Load(d, targets + i),
+                                            hn::Load(d, rom_weights + i), hn::Load(d, rom_shifts + i));
         hn::Store(target, d, targets + i);
         hn::Store(LcdIndexAt(d, shape, target, held ? held_row : previous_row(s + i)), d, words + i);
       }
@@ -2527,6 +2554,7 @@ HWY_EXPORT(GaussianColumns32);
 HWY_EXPORT(GaussianRows32);
 HWY_EXPORT(LcdDrive);
 HWY_EXPORT(LcdSearch);
+HWY_EXPORT(LcdTargets);
 HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(StoreResiduals);
@@ -2603,6 +2631,10 @@ void gaussian_rows(const std::uint32_t* const* rows, const std::uint32_t* weight
 void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& plan,
                 std::uint16_t* codes) {
   HWY_DYNAMIC_DISPATCH(LcdSearch)(target, rows, n, plan, codes);
+}
+void lcd_targets(const std::int64_t* sum, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                 std::int64_t* target) {
+  HWY_DYNAMIC_DISPATCH(LcdTargets)(sum, n, plan, kernels, target);
 }
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
                         std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,

@@ -357,6 +357,10 @@ std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan
 // binary search, for target[s] in [0, one].
 void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_t n, const LcdPlan& plan,
                 std::uint16_t* codes);
+// target[s] = FixedKernels::lcd_target(sum[s]): the LCD drive's target m of x_t + x_{t-1} = sum[s] through the plan's
+// ROM, uQ1.F.
+void lcd_targets(const std::int64_t* sum, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                 std::int64_t* target);
 // Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
 // whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions
 // of `kernels`.

@@ -160,10 +160,10 @@ Raw FixedKernels::lcd_drive_value(const std::array<Raw, 4>& p, Raw target_scaled
   const fx::detail::int128 span = m_hi - m_lo;
   if (span <= 0) return (t_lo << config_.drive_frac_bits) / two_top;  // coefficients quantised to a flat merge
   const fx::detail::int128 offset = std::clamp<fx::detail::int128>(target_scaled - m_lo, 0, span);
-  const fx::detail::int128 numerator = (static_cast<fx::detail::int128>(t_lo) * span + offset * (t_hi - t_lo))
-                                       << config_.drive_frac_bits;
-  const fx::detail::int128 denominator = span * two_top;
-  return static_cast<Raw>((numerator + denominator / 2) / denominator);
+  // v = round(2^D (t_lo span + offset dt) / (span 2 Mx)), half up: every operand is non-negative.
+  return static_cast<Raw>(
+      fx::detail::rounded_quotient(static_cast<fx::detail::uint128>(t_lo * span + offset * (t_hi - t_lo)),
+                                   config_.drive_frac_bits, static_cast<fx::detail::uint128>(span * two_top)));
 }
 
 LcdSample FixedKernels::lcd_drive(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
@@ -235,13 +235,26 @@ void FixedKernels::lcd_reports(const Linear* wanted, const std::int32_t* previou
     }
     return;
   }
-  for (std::size_t s = 0; s < n; ++s) {  // lcd_solve's steps past the held frame, the code given
-    const Raw sum = Raw{wanted[s]} + previous_wanted[s];
-    const Raw j = previous_code[s];
-    const int end = lcd_clamped_end(sum, j);
-    drive[s] = end >= 0 ? lcd_clamped_drive(end == 1)
-                        : lcd_drive_value(lcd_coefficients_, lcd_target_scaled(sum), codes[s], j);
-    previous[s] = previous_code[s];
+  // lcd_solve's steps past the held frame, the code given: the targets of a chunk by the line kernel where it runs.
+  constexpr std::size_t kChunk = 256;
+  std::array<Raw, kChunk> sums;
+  std::array<Raw, kChunk> targets;
+  for (std::size_t start = 0; start < n; start += kChunk) {
+    const std::size_t count = std::min(kChunk, n - start);
+    for (std::size_t i = 0; i < count; ++i) sums[i] = Raw{wanted[start + i]} + previous_wanted[start + i];
+    if (line_plans_.lcd) {
+      lines::lcd_targets(sums.data(), count, *line_plans_.lcd, *this, targets.data());
+    } else {
+      for (std::size_t i = 0; i < count; ++i) targets[i] = lcd_target(sums[i]);
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t s = start + i;
+      const Raw j = previous_code[s];
+      const int end = lcd_clamped_end(sums[i], j);
+      drive[s] = end >= 0 ? lcd_clamped_drive(end == 1)
+                          : lcd_drive_value(lcd_coefficients_, scale_lcd_target(targets[i]), codes[s], j);
+      previous[s] = previous_code[s];
+    }
   }
 }
 

@@ -694,6 +694,59 @@ TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
   }
 }
 
+// The LCD target kernel against the stage function: sums at every octave's and segment's ends of the target ROM's
+// input and either side (and the LSBs below the input), random sums, and sums at or below 0 and at or above 2 (the
+// clamped ends), on every instruction set; F = 20, 24 (two bits below the ROM's 24-bit input) and 28, and 1, 64 and
+// 512 segments an octave.
+TEST(FixedLines, LcdTargetKernelGivesTheStageFunctionsTargets) {
+  std::vector<FixedDecoderConfig> configs = {fixed_config(link_config(0.5), "lcd")};
+  for (const auto& [frac_bits, segments] : {std::pair{20, 64}, std::pair{26, 1}, std::pair{28, 512}}) {
+    configs.push_back(configs[0]);
+    configs.back().linear_frac_bits = frac_bits;
+    configs.back().residual.frac_bits = frac_bits;
+    configs.back().lcd_segments_per_octave = segments;
+  }
+  for (const FixedDecoderConfig& config : configs) {
+    const fixed_detail::FixedKernels kernels(config);
+    ASSERT_TRUE(kernels.line_plans().lcd.has_value());
+    const fixed_detail::LcdPlan& plan = *kernels.line_plans().lcd;
+    const std::int64_t two = 2 * kernels.one();
+    const int shift = plan.target_shift;
+    std::vector<std::int64_t> sums = {-two, -1, 0, 1, two - 1, two, two + 1, std::int64_t{1} << 40};
+    const std::int64_t segments = std::int64_t{1} << plan.segments_per_octave_log2;
+    for (int k = 0; k < plan.target_input_bits; ++k) {
+      const std::int64_t start = std::int64_t{1} << k;
+      for (std::int64_t j = 0; j <= segments; ++j) {
+        const std::int64_t input = start + j * start / segments;
+        for (const std::int64_t c : {input - 1, input, input + 1}) {
+          for (const std::int64_t low : {std::int64_t{0}, (std::int64_t{1} << shift) - 1}) {
+            const std::int64_t sum = (c << shift) + low;
+            if (sum >= 0 && sum <= two) sums.push_back(sum);
+          }
+        }
+      }
+    }
+    std::mt19937_64 random(37);
+    std::uniform_int_distribution<std::int64_t> in_range(0, two);
+    for (int i = 0; i < 20000; ++i) sums.push_back(in_range(random));
+    std::vector<std::int64_t> expected(sums.size());
+    for (std::size_t s = 0; s < sums.size(); ++s) expected[s] = kernels.lcd_target(sums[s]);
+    ASSERT_EQ(expected[1], 0);
+    ASSERT_EQ(expected[5], kernels.one());
+    const std::string what = "F=" + std::to_string(config.linear_frac_bits) + " " +
+                             std::to_string(config.lcd_segments_per_octave) + " segments per octave";
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      std::vector<std::int64_t> targets(sums.size());
+      fixed_detail::lines::lcd_targets(sums.data(), sums.size(), plan, kernels, targets.data());
+      for (std::size_t s = 0; s < sums.size(); ++s) {
+        ASSERT_EQ(targets[s], expected[s]) << hwy::TargetName(target) << " " << what << " sample " << s << " sum "
+                                           << sums[s];
+      }
+    }
+  }
+}
+
 // ROMs with thresholds where a float conversion or a bucket's bounds could go wrong, up to the index's 2^30, through
 // the two-gather search and the packed single gather:
 //   * ends: at 2^k - 1, 2^k and the second bucket of each octave, 2^k + 2^(k-7): the last value of an octave and of

@@ -1,6 +1,7 @@
 // The 64-bit shortcuts of the hot paths against the 128-bit quantiser they stand in for: rounded_shift on int64 at the
 // extremes of the range and every shift, and LUT interpolation at every weight width, in tables whose words and
-// steps make the shortcut apply, stop applying, or never apply (rounding other than half up).
+// steps make the shortcut apply, stop applying, or never apply (rounding other than half up); and the rounded
+// quotient's double estimate against the 128-bit division.
 #include "trm/fixed_runtime.hpp"
 #include "trm/lut.hpp"
 
@@ -29,6 +30,57 @@ TEST(FastPath, RoundedShiftOnInt64MatchesTheWideQuantiserAtTheExtremes) {
       }
     }
   }
+}
+
+// rounded_quotient against the division it stands in for: quotients a half away from an integer and either side of
+// it (where an estimate off by one must be corrected, in both directions), quotients either side of the estimate's
+// bound 2^50 and operands either side of 2^64 (the division itself), at every shift of the fast path and beyond.
+TEST(FastPath, RoundedQuotientIsTheDivisionsQuotient) {
+  using detail::uint128;
+  std::mt19937_64 rng(43);
+  std::uint64_t checked = 0;
+  const auto check = [&](uint128 part, int shift, uint128 denominator) {
+    const uint128 expected = ((part << shift) + denominator / 2) / denominator;
+    if (denominator == 0 || (expected >> 64) != 0) return;
+    ASSERT_EQ(detail::rounded_quotient(part, shift, denominator), static_cast<std::uint64_t>(expected))
+        << "part " << static_cast<std::uint64_t>(part) << " (high " << static_cast<std::uint64_t>(part >> 64)
+        << ") shift " << shift << " denominator " << static_cast<std::uint64_t>(denominator) << " (high "
+        << static_cast<std::uint64_t>(denominator >> 64) << ")";
+    ++checked;
+  };
+  for (int shift = 0; shift <= 34; ++shift) {
+    for (int i = 0; i < 4000; ++i) {
+      // An odd denominator 2d + 1 and q + 1/2 = (part 2^shift + d) / (2d + 1) + 1/2: part 2^shift = q (2d + 1) + d
+      // + delta sits delta / (2d + 1) from the half (delta in [-2, 2]); part is its nearest multiple of 2^shift.
+      const int denominator_bits = 1 + static_cast<int>(rng() % 63);
+      const uint128 denominator = (rng() >> (64 - denominator_bits)) | 1;
+      const int quotient_bits = static_cast<int>(rng() % 52);
+      const uint128 q = quotient_bits == 0 ? 0 : rng() >> (64 - quotient_bits);
+      for (int delta = -2; delta <= 2; ++delta) {
+        const uint128 scaled =
+            q * denominator + denominator / 2 + static_cast<uint128>(static_cast<std::int64_t>(delta));
+        check(scaled >> shift, shift, denominator);
+        check((scaled >> shift) + 1, shift, denominator);
+      }
+      // Random operands, the largest part first.
+      check(rng(), shift, rng() >> (rng() % 64));
+      check(rng() >> (rng() % 64), shift, (rng() >> (rng() % 64)) + 1);
+    }
+    // The estimate's bound: quotients 2^50 - 1, 2^50, 2^50 + 1 before rounding.
+    for (const std::uint64_t denominator :
+         {std::uint64_t{1}, std::uint64_t{3}, std::uint64_t{1} << 13, (std::uint64_t{1} << 13) + 1}) {
+      for (const std::int64_t d : {-1, 0, 1}) {
+        const uint128 target = (uint128{1} << 50) + static_cast<uint128>(d);
+        check((target * denominator) >> shift, shift, denominator);
+      }
+    }
+    // Operands at and past 64 bits.
+    const uint128 k64 = uint128{1} << 64;
+    for (const uint128 part : {k64 - 1, k64, k64 + 1}) {
+      for (const uint128 denominator : {k64 - 1, k64, k64 + 1, uint128{1} << 80}) check(part, shift, denominator);
+    }
+  }
+  EXPECT_GT(checked, 34u * 4000u * 10u);
 }
 
 // y0 + (y1 - y0) w / 2^bits rounded by the table's own mode, exactly (the definition interpolate implements).

@@ -90,6 +90,29 @@ constexpr int128 shift_left(int128 x, int s) { return static_cast<int128>(static
 // and floor(x / 2^s) = ~(~x >> s).
 constexpr int128 floor_shift_right(int128 x, int s) { return x >= 0 ? (x >> s) : ~((~x) >> s); }
 
+// floor((part 2^shift + floor(denominator / 2)) / denominator): part 2^shift / denominator rounded half up, for
+// denominator > 0, 0 <= shift < 128 and a result below 2^64. Where part and the denominator fit 64 bits, shift <= 30
+// and the quotient q is below 2^50, their doubles give q within 3 q 2^-53 + ulp(q) / 2 < 1/2, so that the estimate
+// is the result or one either side of it, which two exact products settle: a few instructions where the 128-bit
+// division is a library call.
+inline std::uint64_t rounded_quotient(uint128 part, int shift, uint128 denominator) {
+  const uint128 rounded = (part << shift) + denominator / 2;
+  constexpr uint128 k64 = uint128{1} << 64;
+  if (part >= k64 || denominator >= k64 || shift > 30 || (part >> (50 - shift)) >= denominator) {
+    return static_cast<std::uint64_t>(rounded / denominator);
+  }
+  const double scale = static_cast<double>(std::uint64_t{1} << shift);
+  auto quotient = static_cast<std::uint64_t>(static_cast<double>(static_cast<std::uint64_t>(part)) * scale /
+                                                 static_cast<double>(static_cast<std::uint64_t>(denominator)) +
+                                             0.5);
+  if (quotient * denominator > rounded) {
+    --quotient;
+  } else if ((quotient + 1) * denominator <= rounded) {
+    ++quotient;
+  }
+  return quotient;
+}
+
 // Number of significant bits of |x| (0 for x = 0).
 constexpr int magnitude_bits(int128 x) {
   const uint128 m = x >= 0 ? static_cast<uint128>(x) : static_cast<uint128>(~x) + 1u;
