@@ -1878,6 +1878,13 @@ std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64
   return packed;
 }
 
+// The same of a ROM's words with the steps between them (the last word's 0).
+std::optional<std::vector<std::int64_t>> packed_rom(const std::vector<std::int64_t>& rom) {
+  std::vector<std::int64_t> step(rom.size(), 0);
+  for (std::size_t i = 0; i + 1 < rom.size(); ++i) step[i] = rom[i + 1] - rom[i];
+  return packed_rom(rom, step);
+}
+
 // The shift form of a uniform ROM (ShiftedRomPlan), where its segment position per code is 2^k with 1 <= k <= 31,
 // it rounds half up, and the interpolation's sum stays in 62 bits.
 std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
@@ -1891,14 +1898,11 @@ std::optional<ShiftedRomPlan> shifted_rom_plan(const fx::InterpolatedLut& lut) {
   const std::vector<std::int64_t>& rom = lut.rom();
   const std::uint64_t top_node = ((std::uint64_t{1} << lut.shape().input_bits) - 1) >> plan.weight_bits;
   if (top_node >= rom.size()) return std::nullopt;
-  std::vector<std::int64_t> step(rom.size(), 0);
   const std::int64_t limit = std::int64_t{1} << (61 - plan.weight_bits);
-  for (std::size_t i = 0; i < rom.size(); ++i) {
-    if (rom[i] <= -limit || rom[i] >= limit) return std::nullopt;
-    if (i + 1 < rom.size()) step[i] = rom[i + 1] - rom[i];
-    if (step[i] < INT32_MIN || step[i] > INT32_MAX) return std::nullopt;
+  for (const std::int64_t word : rom) {
+    if (word <= -limit || word >= limit) return std::nullopt;
   }
-  std::optional<std::vector<std::int64_t>> packed = packed_rom(rom, step);
+  std::optional<std::vector<std::int64_t>> packed = packed_rom(rom);
   if (!packed) return std::nullopt;
   plan.packed = std::move(*packed);
   return plan;
@@ -1931,10 +1935,7 @@ std::optional<DriveValuePlan> drive_value_plan(const std::array<const fx::Interp
     plan.top_code = (std::int64_t{1} << shape.input_bits) - 1;
     plan.bottom_region_bits = lut.bottom_region_bits();
     plan.segments_per_octave_log2 = segments_log2;
-    const std::vector<std::int64_t>& rom = lut.rom();
-    std::vector<std::int64_t> step(rom.size(), 0);
-    for (std::size_t i = 0; i + 1 < rom.size(); ++i) step[i] = rom[i + 1] - rom[i];
-    std::optional<std::vector<std::int64_t>> packed = packed_rom(rom, step);
+    std::optional<std::vector<std::int64_t>> packed = packed_rom(lut.rom());
     if (!packed) return std::nullopt;
     first[static_cast<std::size_t>(ch)] = static_cast<std::int64_t>(plan.packed.size());
     plan.packed.insert(plan.packed.end(), packed->begin(), packed->end());
@@ -2069,9 +2070,7 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
     }
     l.contributed = c.decoder.lcd_history == LcdHistory::Contributed;
     const std::vector<std::int64_t>& rom = target.rom();
-    std::vector<std::int64_t> step(rom.size(), 0);
-    for (std::size_t i = 0; i + 1 < rom.size(); ++i) step[i] = rom[i + 1] - rom[i];
-    std::optional<std::vector<std::int64_t>> packed = packed_rom(rom, step);
+    std::optional<std::vector<std::int64_t>> packed = packed_rom(rom);
     // 32-bit operands for the target's scaling and the ROM weight (scale bits up to the ROM's 24 address bits), the
     // octave nodes within the ROM, the merges of every (v_{t-1}, k) present.
     const bool fits = packed && F <= 30 && (std::int64_t{1} << l.width_log2) == l.width && scale < (std::uint64_t{1} << 32) && l.target_shift >= 0 &&
