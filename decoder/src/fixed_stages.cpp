@@ -227,33 +227,38 @@ template <typename Linear>
 void FixedKernels::lcd_reports(const Linear* wanted, const std::int32_t* previous_wanted,
                                const std::uint8_t* previous_code, const std::uint16_t* codes, std::size_t n, bool held,
                                Raw* drive, std::uint16_t* previous) const {
-  if (held) {
+  const std::optional<LcdPlan>& plan = line_plans_.lcd;
+  if (!plan) {
     for (std::size_t s = 0; s < n; ++s) {
-      const LcdSample sample = lcd_report(wanted[s], previous_wanted[s], previous_code[s], true, codes[s]);
+      const LcdSample sample = lcd_report(wanted[s], previous_wanted[s], previous_code[s], held, codes[s]);
       drive[s] = sample.drive;
       previous[s] = sample.previous_code;
     }
     return;
   }
-  // lcd_solve's steps past the held frame, the code given: the targets of a chunk by the line kernel where it runs.
+  // lcd_solve's steps, the code given, a chunk at a time: the targets by the target ROM's kernel, and on the eye's
+  // first frame (x_{t-1} = x_t) v_{t-1} by the search of the merge table's held row (lcd_held_code).
   constexpr std::size_t kChunk = 256;
   std::array<Raw, kChunk> sums;
   std::array<Raw, kChunk> targets;
+  std::array<Raw, kChunk> held_row;
+  std::array<std::uint16_t, kChunk> held_codes;
+  if (held) held_row.fill(plan->width);
   for (std::size_t start = 0; start < n; start += kChunk) {
     const std::size_t count = std::min(kChunk, n - start);
-    for (std::size_t i = 0; i < count; ++i) sums[i] = Raw{wanted[start + i]} + previous_wanted[start + i];
-    if (line_plans_.lcd) {
-      lines::lcd_targets(sums.data(), count, *line_plans_.lcd, *this, targets.data());
-    } else {
-      for (std::size_t i = 0; i < count; ++i) targets[i] = lcd_target(sums[i]);
+    for (std::size_t i = 0; i < count; ++i) {
+      const Raw x = wanted[start + i];
+      sums[i] = held ? 2 * x : x + previous_wanted[start + i];
     }
+    lines::lcd_targets(sums.data(), count, *plan, *this, targets.data());
+    if (held) lines::lcd_search(targets.data(), held_row.data(), count, *plan, held_codes.data());
     for (std::size_t i = 0; i < count; ++i) {
       const std::size_t s = start + i;
-      const Raw j = previous_code[s];
+      const std::uint16_t j = held ? held_codes[i] : previous_code[s];
       const int end = lcd_clamped_end(sums[i], j);
       drive[s] = end >= 0 ? lcd_clamped_drive(end == 1)
                           : lcd_drive_value(lcd_coefficients_, scale_lcd_target(targets[i]), codes[s], j);
-      previous[s] = previous_code[s];
+      previous[s] = j;
     }
   }
 }
