@@ -217,6 +217,13 @@ class FixedKernels {
   // without the search.
   LcdSample lcd_report(Raw wanted, Raw previous_wanted, std::uint16_t previous_code, bool held,
                        std::uint16_t code) const;
+  // lcd_report's drive value of a sample whose x_t + x_{t-1} = sum, whose target m = lcd_target(sum), v_{t-1} = j and
+  // code `code`: the clamped end's where the sum is unreachable, else v between the code's thresholds.
+  Raw lcd_report_drive(Raw sum, Raw target, Raw j, std::uint16_t code) const {
+    const int end = lcd_clamped_end(sum, j);
+    return end >= 0 ? lcd_clamped_drive(end == 1)
+                    : lcd_drive_value(lcd_coefficients_, scale_lcd_target(target), code, j);
+  }
   // lcd_report of the n samples of a line whose codes the LCD drive kernel gave: drive[s] and previous[s] are
   // lcd_report(wanted[s], previous_wanted[s], previous_code[s], held, codes[s])'s drive and previous_code.
   template <typename Linear>

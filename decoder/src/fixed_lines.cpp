@@ -157,10 +157,9 @@ HWY_INLINE OctavePlace<D> OctaveRomPlace(D d, hn::Vec<D> code, hn::Vec<D> bottom
                         hn::And(scaled, hn::Sub(hn::Shl(unit, scale_bits), unit)), scale_bits};
 }
 
-// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1].
+// table[at] and table[at + 1] of each 64-bit lane.
 template <class D>
-HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn::Vec<D>& first, hn::Vec<D>& second) {
-  const auto at = hn::Add(index, index);
+HWY_INLINE void LookupAdjacent(D d, const std::int64_t* table, hn::Vec<D> at, hn::Vec<D>& first, hn::Vec<D>& second) {
   if constexpr (hn::MaxLanes(d) == 4) {
     hn::Vec<D> low, high;
     LoadWordPairs(d, table, at, low, high);
@@ -170,6 +169,12 @@ HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn
     first = hn::GatherIndex(d, table, at);
     second = hn::GatherIndex(d, table + 1, at);
   }
+}
+
+// first[i] = table[2 index[i]], second[i] = table[2 index[i] + 1].
+template <class D>
+HWY_INLINE void LookupPairs(D d, const std::int64_t* table, hn::Vec<D> index, hn::Vec<D>& first, hn::Vec<D>& second) {
+  LookupAdjacent(d, table, hn::Add(index, index), first, second);
 }
 #endif
 
@@ -1168,6 +1173,93 @@ void LcdTargets(const std::int64_t* sum, std::size_t n, const LcdPlan& p, const 
   for (; s < n; ++s) target[s] = kernels.lcd_target(sum[s]);
 }
 
+#if HWY_TARGET != HWY_SCALAR
+// a b mod 2^64 of 64-bit lanes for a below 2^32 (the products a b_low and a b_high by MulEven).
+template <class D>
+HWY_INLINE hn::Vec<D> MulNarrow(D d, hn::Vec<D> a, hn::Vec<D> b) {
+  const hn::RebindToUnsigned<D> du;
+  const hn::Repartition<std::uint32_t, decltype(du)> du32;
+  const auto a32 = hn::BitCast(du32, a);
+  const auto low = hn::MulEven(a32, hn::BitCast(du32, b));
+  const auto high = hn::MulEven(a32, hn::BitCast(du32, hn::ShiftRight<32>(hn::BitCast(du, b))));
+  return hn::BitCast(d, hn::Add(low, hn::ShiftLeft<32>(high)));
+}
+#endif
+
+void LcdDriveValues(const std::int64_t* sum, const std::int64_t* target, const std::uint16_t* rows,
+                    const std::uint16_t* codes, std::size_t n, const LcdPlan& p, const FixedKernels& kernels,
+                    std::int64_t* drive) {
+  std::size_t s = 0;
+#if HWY_TARGET != HWY_SCALAR
+  if (!p.report_merge.empty()) {
+    const hn::ScalableTag<std::int64_t> d;
+    const hn::RebindToUnsigned<decltype(d)> du;
+    const hn::Repartition<std::uint32_t, decltype(du)> du32;
+    const hn::Rebind<std::uint32_t, decltype(du)> du32h;
+    const hn::Rebind<std::uint16_t, decltype(du)> d16;
+    const hn::Rebind<double, decltype(d)> df;
+    const std::size_t lanes = hn::Lanes(d);
+    const auto zero = hn::Zero(d);
+    const auto one = hn::Set(d, std::int64_t{1});
+    const auto two_top = hn::Set(d, 2 * std::int64_t{p.top});
+    const auto row_words = hn::Set(d, p.report_row_words);
+    const auto scale = hn::BitCast(du32, hn::Set(du, std::uint64_t{p.scale}));
+    const int shift = p.drive_frac_bits;
+    const auto full_drive = hn::Set(d, std::int64_t{1} << shift);
+    const auto drive_scale = hn::Set(df, static_cast<double>(std::int64_t{1} << shift));
+    const auto half = hn::Set(df, 0.5);
+    const std::int64_t* merge = p.report_merge.data();
+    const std::int64_t* ends = p.ends.data();
+    const auto widen = [&](const std::uint16_t* v) {
+      return hn::BitCast(d, hn::PromoteTo(du, hn::PromoteTo(du32h, hn::LoadU(d16, v))));
+    };
+    for (; s + lanes <= n; s += lanes) {
+      const auto x_sum = hn::LoadU(d, sum + s);
+      const auto j = widen(rows + s);
+      const auto code = widen(codes + s);
+      // The unreachable ends (FixedKernels::lcd_clamped_end): below the dark end 0, above the bright end 1.
+      hn::Vec<decltype(d)> dark, bright;
+      LookupPairs(d, ends, j, dark, bright);
+      const auto below = hn::Lt(x_sum, hn::Add(dark, dark));
+      const auto above = hn::Gt(x_sum, hn::Add(bright, bright));
+      // FixedKernels::lcd_drive_value: the merges at the code's thresholds t_lo = max(2c - 1, 0) and t_hi = min(2c +
+      // 1, 2 Mx), side by side in the row of v_{t-1}, and round(2^D (t_lo span + offset dt) / (span 2 Mx)), half up.
+      hn::Vec<decltype(d)> m_lo, m_hi;
+      LookupAdjacent(d, merge, hn::Add(MulNarrow(d, j, row_words), code), m_lo, m_hi);
+      const auto t_lo = hn::Max(hn::Sub(hn::Add(code, code), one), zero);
+      const auto t_hi = hn::Min(hn::Add(hn::Add(code, code), one), two_top);
+      const auto span = hn::Sub(m_hi, m_lo);
+      const auto target_scaled = hn::BitCast(d, hn::MulEven(hn::BitCast(du32, hn::LoadU(d, target + s)), scale));
+      const auto offset = hn::Min(hn::Max(hn::Sub(target_scaled, m_lo), zero), span);
+      const auto offset_dt = hn::IfThenElse(hn::Eq(hn::Sub(t_hi, t_lo), one), offset, hn::Add(offset, offset));
+      // Below 2^63 and 2^62 (LcdPlan::report_merge).
+      const auto part = hn::Add(MulNarrow(d, t_lo, span), offset_dt);
+      const auto denominator = MulNarrow(d, two_top, span);
+      // The quotient within one of the estimate (fx::detail::rounded_quotient), settled by the remainder, which lies
+      // in [-denominator, 2 denominator) and so is exact mod 2^64.
+      const auto estimate = hn::Add(
+          hn::Div(hn::Mul(hn::ConvertTo(df, part), drive_scale), hn::ConvertTo(df, denominator)), half);
+      auto quotient = hn::ConvertTo(d, estimate);
+      const auto rounded = hn::Add(hn::ShiftLeftSame(part, shift), hn::ShiftRight<1>(denominator));
+      const auto remainder = hn::Sub(rounded, MulNarrow(d, quotient, denominator));
+      quotient = hn::IfThenElse(hn::Lt(remainder, zero), hn::Sub(quotient, one),
+                                hn::IfThenElse(hn::Lt(remainder, denominator), quotient, hn::Add(quotient, one)));
+      const auto value = hn::IfThenElseZero(hn::Not(below), hn::IfThenElse(above, full_drive, quotient));
+      hn::StoreU(value, d, drive + s);
+      // A flat merge (quantised coefficients) takes the stage function, as its division by a zero span would.
+      if (!hn::AllFalse(d, hn::AndNot(hn::Or(below, above), hn::Not(hn::Gt(span, zero))))) {
+        for (std::size_t k = s; k < s + lanes; ++k) {
+          drive[k] = kernels.lcd_report_drive(sum[k], target[k], rows[k], codes[k]);
+        }
+      }
+    }
+  }
+#else
+  (void)p;
+#endif
+  for (; s < n; ++s) drive[s] = kernels.lcd_report_drive(sum[s], target[s], rows[s], codes[s]);
+}
+
 // One sample of the LCD drive by the stage function, with emit's frame-store update.
 inline std::uint16_t lcd_scalar(std::int64_t wanted, const LcdPlan& p, const FixedKernels& kernels,
                                 std::uint8_t& previous_code, std::int32_t& previous_linear, bool held,
@@ -1988,6 +2080,28 @@ std::optional<MotionPlan> motion_plan(const FixedKernels& kernels, const std::ar
   return m;
 }
 
+// LcdPlan::report_merge of a plan (its top and width set); merge(t, j): FixedKernels::scaled_merge of the panel's
+// coefficients.
+template <typename Merge>
+void lcd_report_table(LcdPlan& plan, Merge merge, int drive_frac_bits) {
+  const std::int64_t two_top = 2 * static_cast<std::int64_t>(plan.top);
+  const std::int64_t words = plan.width + 1;
+  std::vector<std::int64_t> table(static_cast<std::size_t>(plan.width * words));
+  constexpr std::int64_t kWordLimit = std::int64_t{1} << 61;
+  const std::int64_t span_limit = (std::int64_t{1} << 62) / (two_top + 2);
+  for (std::int64_t j = 0; j < plan.width; ++j) {
+    std::int64_t* row = table.data() + j * words;
+    for (std::int64_t c = 0; c < words; ++c) {
+      row[c] = merge(std::clamp<std::int64_t>(2 * c - 1, 0, two_top), j);
+      if (row[c] <= -kWordLimit || row[c] >= kWordLimit) return;
+      if (c > 0 && row[c] - row[c - 1] >= span_limit) return;
+    }
+  }
+  plan.report_merge = std::move(table);
+  plan.report_row_words = words;
+  plan.drive_frac_bits = drive_frac_bits;
+}
+
 }  // namespace
 
 FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
@@ -2084,6 +2198,9 @@ FixedLinePlans FixedLinePlans::build(const FixedKernels& kernels) {
       l.target_packed = std::move(*packed);
       lcd_search_index(l);
       lcd_composed_index(l, target);
+      lcd_report_table(
+          l, [&](std::int64_t t, std::int64_t j) { return kernels.scaled_merge(kernels.lcd_coefficients_, t, j); },
+          c.drive_frac_bits);
       plans.lcd = std::move(l);
     }
   }
@@ -2554,6 +2671,7 @@ HWY_EXPORT(GaussianRows32);
 HWY_EXPORT(LcdDrive);
 HWY_EXPORT(LcdSearch);
 HWY_EXPORT(LcdTargets);
+HWY_EXPORT(LcdDriveValues);
 HWY_EXPORT(MotionWeights);
 HWY_EXPORT(AddWeightedResiduals);
 HWY_EXPORT(StoreResiduals);
@@ -2634,6 +2752,11 @@ void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_
 void lcd_targets(const std::int64_t* sum, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
                  std::int64_t* target) {
   HWY_DYNAMIC_DISPATCH(LcdTargets)(sum, n, plan, kernels, target);
+}
+void lcd_drive_values(const std::int64_t* sum, const std::int64_t* target, const std::uint16_t* rows,
+                      const std::uint16_t* codes, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                      std::int64_t* drive) {
+  HWY_DYNAMIC_DISPATCH(LcdDriveValues)(sum, target, rows, codes, n, plan, kernels, drive);
 }
 std::uint64_t lcd_drive(const std::int64_t* wanted, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
                         std::uint8_t* previous_code, std::int32_t* previous_linear, bool held, std::uint16_t* codes,

@@ -265,6 +265,14 @@ struct LcdPlan {
   // Per v_{t-1}: 2 M(0, v_{t-1})^gamma in the low 32 bits, 2 M(1, v_{t-1})^gamma in the high, the
   // sums' unreachable ends for the composed kernel's 32-bit lanes (both at most 2^30 wherever composed is built).
   std::vector<std::uint64_t> ends32;
+  // The report's drive value (FixedKernels::lcd_report_drive: v between the code's thresholds, interpolated in M) of
+  // lcd_drive_values: per v_{t-1} = j, report_row_words = 2^o + 1 words M(clamp(2c - 1, 0, 2 Mx), j) scaled as the
+  // merge table, c = 0 .. 2^o (the thresholds either side of code c at c and c + 1). Built where every positive span
+  // between them stays below 2^62 / (2 Mx + 2), and every word within (-2^61, 2^61), so that the interpolation's
+  // operands and its denominator fit 63 bits; empty otherwise.
+  std::vector<std::int64_t> report_merge;
+  std::int64_t report_row_words = 0;
+  int drive_frac_bits = 0;
 };
 
 // The per-row target index of an LCD plan (LcdPlan::index): the coarsest bucket width that holds at most one
@@ -361,6 +369,11 @@ void lcd_search(const std::int64_t* target, const std::int64_t* rows, std::size_
 // ROM, uQ1.F.
 void lcd_targets(const std::int64_t* sum, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
                  std::int64_t* target);
+// drive[s] = FixedKernels::lcd_report_drive(sum[s], target[s], rows[s], codes[s]): the LCD's report drive value of
+// a sample whose x_t + x_{t-1} = sum[s], whose target m = lcd_target(sum[s]), v_{t-1} = rows[s] and code codes[s].
+void lcd_drive_values(const std::int64_t* sum, const std::int64_t* target, const std::uint16_t* rows,
+                      const std::uint16_t* codes, std::size_t n, const LcdPlan& plan, const FixedKernels& kernels,
+                      std::int64_t* drive);
 // Eqs. 5-6 per pixel: weight[x] = motion_weight(luma(previous + 3x), luma(alpha + 3x)) for x < pixels. Pixels
 // whose operands leave the plan's lanes (values outside [0, 1], sums too small to normalise) take the stage functions
 // of `kernels`.

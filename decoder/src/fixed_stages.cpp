@@ -242,7 +242,7 @@ void FixedKernels::lcd_reports(const Linear* wanted, const std::int32_t* previou
   std::array<Raw, kChunk> sums;
   std::array<Raw, kChunk> targets;
   std::array<Raw, kChunk> held_row;
-  std::array<std::uint16_t, kChunk> held_codes;
+  std::array<std::uint16_t, kChunk> rows;
   if (held) held_row.fill(plan->width);
   for (std::size_t start = 0; start < n; start += kChunk) {
     const std::size_t count = std::min(kChunk, n - start);
@@ -251,15 +251,14 @@ void FixedKernels::lcd_reports(const Linear* wanted, const std::int32_t* previou
       sums[i] = held ? 2 * x : x + previous_wanted[start + i];
     }
     lines::lcd_targets(sums.data(), count, *plan, *this, targets.data());
-    if (held) lines::lcd_search(targets.data(), held_row.data(), count, *plan, held_codes.data());
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t s = start + i;
-      const std::uint16_t j = held ? held_codes[i] : previous_code[s];
-      const int end = lcd_clamped_end(sums[i], j);
-      drive[s] = end >= 0 ? lcd_clamped_drive(end == 1)
-                          : lcd_drive_value(lcd_coefficients_, scale_lcd_target(targets[i]), codes[s], j);
-      previous[s] = j;
+    if (held) {
+      lines::lcd_search(targets.data(), held_row.data(), count, *plan, rows.data());
+    } else {
+      std::copy_n(previous_code + start, count, rows.data());
     }
+    lines::lcd_drive_values(sums.data(), targets.data(), rows.data(), codes + start, count, *plan, *this,
+                            drive + start);
+    std::copy_n(rows.data(), count, previous + start);
   }
 }
 

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -745,6 +746,177 @@ TEST(FixedLines, LcdTargetKernelGivesTheStageFunctionsTargets) {
       }
     }
   }
+}
+
+// The LCD's report drive value kernel against the stage function, operand by operand: random x_t and x_{t-1} (and
+// values outside [0, 1], which the contributed history stores), every v_{t-1}, the code the drive gives and random
+// codes (the interpolation clamps the target to the code's thresholds), sums at the unreachable ends; on every
+// instruction set, at drive_frac_bits 8, 16 and 30, F = 20 and 28, and a panel of other coefficients.
+TEST(FixedLines, LcdDriveValueKernelGivesTheStageFunctionsValues) {
+  std::vector<FixedDecoderConfig> configs = {fixed_config(link_config(0.5), "lcd")};
+  configs.push_back(configs[0]);
+  configs.back().drive_frac_bits = 8;
+  configs.back().linear_frac_bits = 20;
+  configs.back().residual.frac_bits = 20;
+  configs.push_back(configs[0]);
+  configs.back().drive_frac_bits = 30;
+  configs.back().linear_frac_bits = 28;
+  configs.back().residual.frac_bits = 28;
+  configs.push_back(fixed_config(link_config(0.5), "lcd:0.3,0.2,0.1,0.05,2.4"));
+  configs.back().decoder.lcd_history = LcdHistory::Contributed;
+  for (const FixedDecoderConfig& config : configs) {
+    const fixed_detail::FixedKernels kernels(config);
+    ASSERT_TRUE(kernels.line_plans().lcd.has_value());
+    const fixed_detail::LcdPlan& plan = *kernels.line_plans().lcd;
+    ASSERT_FALSE(plan.report_merge.empty()) << "the kernel's table is built at these formats";
+    const std::int64_t one = kernels.one();
+    std::mt19937_64 random(41);
+    std::uniform_int_distribution<std::int64_t> linear(-one / 8, one + one / 8);
+    std::uniform_int_distribution<int> code_of(0, plan.top);
+    std::vector<std::int64_t> wanted, previous_wanted;
+    std::vector<std::uint16_t> rows, codes;
+    for (int i = 0; i < 30000; ++i) {
+      const std::int64_t x = i % 7 == 0 ? std::clamp<std::int64_t>(linear(random), 0, one) : linear(random);
+      const std::int64_t x_previous = i % 5 == 0 ? x : linear(random);
+      // v_{t-1} at random, or the code that held x_{t-1} (mostly reachable).
+      const auto j = i % 2 == 0 ? static_cast<std::uint16_t>(code_of(random))
+                                : kernels.lcd_drive(x_previous, 0, 0, true, false).code;
+      const fixed_detail::LcdSample sample = kernels.lcd_drive(x, x_previous, j, false, false);
+      wanted.push_back(x);
+      previous_wanted.push_back(x_previous);
+      rows.push_back(j);
+      codes.push_back(i % 3 == 0 ? static_cast<std::uint16_t>(code_of(random)) : sample.code);
+    }
+    for (const std::uint16_t j : {std::uint16_t{0}, static_cast<std::uint16_t>(plan.top)}) {  // black and white rows
+      for (const std::int64_t x : {std::int64_t{0}, one}) {
+        for (const std::int64_t x_previous : {std::int64_t{0}, one}) {
+          wanted.push_back(x);
+          previous_wanted.push_back(x_previous);
+          rows.push_back(j);
+          codes.push_back(kernels.lcd_drive(x, x_previous, j, false, false).code);
+        }
+      }
+    }
+    const std::size_t n = wanted.size();
+    std::vector<std::int64_t> sums(n), targets(n), expected(n);
+    std::size_t unreachable = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+      sums[s] = wanted[s] + previous_wanted[s];
+      targets[s] = kernels.lcd_target(sums[s]);
+      const fixed_detail::LcdSample sample =
+          kernels.lcd_report(wanted[s], previous_wanted[s], rows[s], false, codes[s]);
+      expected[s] = sample.drive;
+      unreachable += sample.unreachable ? 1 : 0;
+    }
+    ASSERT_GT(unreachable, 100u) << "the operands reach both kinds of samples";
+    ASSERT_LT(unreachable, n / 2);
+    const std::string what = config.decoder.panel.name + " D=" + std::to_string(config.drive_frac_bits) +
+                             " F=" + std::to_string(config.linear_frac_bits);
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      const TargetMock mock(target);
+      std::vector<std::int64_t> drive(n);
+      fixed_detail::lines::lcd_drive_values(sums.data(), targets.data(), rows.data(), codes.data(), n, plan, kernels,
+                                            drive.data());
+      for (std::size_t s = 0; s < n; ++s) {
+        ASSERT_EQ(drive[s], expected[s]) << hwy::TargetName(target) << " " << what << " sample " << s << " x "
+                                         << wanted[s] << " x_previous " << previous_wanted[s] << " row " << rows[s]
+                                         << " code " << codes[s];
+      }
+    }
+  }
+}
+
+// The same kernel's quotient where its double estimate is wrong: exactly on a rounding half with operands of 60 bits
+// and more, whose doubles are rounded, so that the estimate lands on either side and only the remainder settles it
+// (and one offset either side). A plan whose target needs no scaling and whose row r serves code r: a span
+// 2^(D+1) u (u odd, the span near 2^52) puts the quotient 2^D (t_lo span + offset dt) / (span 2 Mx) on k + 1/2 at
+// offset u ((2k + 1) 2 Mx - t_lo 2^(D+1)) / dt, and the row's words are placed so that this offset is the target
+// 2^31. The definition of lcd_drive_value, in 128 bits, is the oracle, at drive_frac_bits 8, 16 and 30, every code.
+TEST(FixedLines, LcdDriveValueKernelSettlesQuotientsOnTheHalf) {
+  using fx::detail::int128;
+  const fixed_detail::FixedKernels kernels(fixed_config(link_config(0.5), "lcd"));
+  ASSERT_TRUE(kernels.line_plans().lcd.has_value());
+  fixed_detail::LcdPlan plan = *kernels.line_plans().lcd;
+  plan.scale = 1;
+  const std::int64_t top = plan.top;
+  const std::int64_t two_top = 2 * top;
+  const std::int64_t words = plan.report_row_words;
+  ASSERT_EQ(words, top + 2);
+  for (std::size_t k = 0; k < plan.ends.size(); k += 2) {  // every sum of 0 reachable
+    plan.ends[k] = -1;
+    plan.ends[k + 1] = 1;
+  }
+  constexpr std::int64_t kTarget = std::int64_t{1} << 31;
+  std::mt19937_64 random(47);
+  std::size_t estimates_low = 0;
+  for (const int drive_frac_bits : {8, 16, 30}) {
+    plan.drive_frac_bits = drive_frac_bits;
+    const std::int64_t u = ((std::int64_t{1} << 52) >> (drive_frac_bits + 1)) - 1;
+    const std::int64_t span = u << (drive_frac_bits + 1);
+    plan.report_merge.assign(static_cast<std::size_t>(plan.width * words), 0);
+    std::vector<std::int64_t> targets;
+    std::vector<std::uint16_t> codes;
+    for (std::int64_t code = 0; code <= top; ++code) {
+      const std::int64_t t_lo = std::max<std::int64_t>(0, 2 * code - 1);
+      const std::int64_t dt = std::min<std::int64_t>(two_top, 2 * code + 1) - t_lo;
+      // The ks whose half lies within the span: (2k + 1) 2 Mx in [t_lo 2^(D+1), (t_lo + dt) 2^(D+1)].
+      const std::int64_t k_first = (t_lo << (drive_frac_bits + 1)) / (2 * two_top);
+      const std::int64_t k_last = ((t_lo + dt) << (drive_frac_bits + 1)) / (2 * two_top) - 1;
+      if (k_last < k_first) continue;
+      const std::int64_t k = std::uniform_int_distribution<std::int64_t>(k_first, k_last)(random);
+      const int128 offset = int128{u} * ((2 * k + 1) * two_top - (t_lo << (drive_frac_bits + 1))) / dt;
+      if (offset < 0 || offset > span) continue;
+      const std::int64_t m_lo = kTarget - static_cast<std::int64_t>(offset);
+      for (std::int64_t c = 0; c < words; ++c) {
+        plan.report_merge[static_cast<std::size_t>(code * words + c)] = m_lo + (c - code) * span;
+      }
+      for (const std::int64_t target : {kTarget - 1, kTarget, kTarget + 1}) {
+        targets.push_back(target);
+        codes.push_back(static_cast<std::uint16_t>(code));
+      }
+    }
+    // Whole vectors of every width: a tail would take the stage function, whose merges are the panel's.
+    while (targets.size() % 8 != 0) {
+      targets.push_back(targets.back());
+      codes.push_back(codes.back());
+    }
+    const std::size_t n = targets.size();
+    const std::vector<std::int64_t> sums(n, 0);
+    const std::vector<std::uint16_t>& rows = codes;
+    std::vector<std::int64_t> expected(n);
+    std::size_t on_half = 0, estimate_high = 0, estimate_low = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+      const std::int64_t t_lo = std::max<std::int64_t>(0, 2 * codes[s] - 1);
+      const std::int64_t t_hi = std::min<std::int64_t>(two_top, 2 * codes[s] + 1);
+      const std::int64_t m_lo = plan.report_merge[static_cast<std::size_t>(codes[s] * words + codes[s])];
+      const std::int64_t offset = std::clamp<std::int64_t>(targets[s] - m_lo, 0, span);
+      const int128 part = int128{t_lo} * span + int128{offset} * (t_hi - t_lo);
+      const int128 denominator = int128{span} * two_top;
+      const int128 rounded = (part << drive_frac_bits) + denominator / 2;
+      expected[s] = static_cast<std::int64_t>(rounded / denominator);
+      on_half += rounded % denominator == 0 ? 1 : 0;
+      const auto estimate = static_cast<std::int64_t>(static_cast<double>(part) * std::ldexp(1.0, drive_frac_bits) /
+                                                          static_cast<double>(denominator) +
+                                                      0.5);
+      estimate_high += estimate > expected[s] ? 1 : 0;
+      estimate_low += estimate < expected[s] ? 1 : 0;
+    }
+    ASSERT_GT(on_half, static_cast<std::size_t>(top / 2)) << "quotients on a rounding half, D=" << drive_frac_bits;
+    EXPECT_GT(estimate_high + estimate_low, 0u) << "estimates the remainder corrects, D=" << drive_frac_bits;
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+      if (target == HWY_SCALAR) continue;  // the stage function throughout
+      const TargetMock mock(target);
+      std::vector<std::int64_t> drive(n);
+      fixed_detail::lines::lcd_drive_values(sums.data(), targets.data(), rows.data(), codes.data(), n, plan, kernels,
+                                            drive.data());
+      for (std::size_t s = 0; s < n; ++s) {
+        ASSERT_EQ(drive[s], expected[s]) << hwy::TargetName(target) << " D=" << drive_frac_bits << " sample " << s
+                                         << " code " << codes[s] << " target " << targets[s];
+      }
+    }
+    estimates_low += estimate_low;
+  }
+  EXPECT_GT(estimates_low, 0u) << "estimates below the quotient, which the remainder raises";
 }
 
 // ROMs with thresholds where a float conversion or a bucket's bounds could go wrong, up to the index's 2^30, through
