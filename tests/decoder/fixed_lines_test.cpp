@@ -528,13 +528,6 @@ TEST(FixedLines, GaussianPolyphaseGivesTheTapsBits) {
   }
 }
 
-// The OLED drive code kernel (both lane widths: the 32-bit tables of DrivePlan and the 64-bit ones) against
-// FixedKernels::drive_code, value by value: every channel's thresholds and their neighbours, both sides of 2^24 (where
-// the 32-bit lanes' float conversion changes form), every octave, random values, and values outside [0, 1] (the
-// generic search), on every instruction set.
-// Both output depths: at 10 bits the index needs up to three steps (the base gather and three threshold gathers); at
-// 8 bits one, which takes the packed single gather (DrivePlan::packed32), and the stepped search of the same tables
-// beside it.
 // result_of(values[s], s mod 3) for every sample s (sample s is read as channel s mod 3).
 template <typename Result>
 auto per_channel(const std::vector<std::int64_t>& values, const Result& result_of) {
@@ -561,6 +554,32 @@ auto on_32bit_line(const std::vector<std::int64_t>& values, std::int64_t filler,
   return std::make_pair(values32, expected32);
 }
 
+// The inputs of an octave-segmented ROM read above `shift` low bits that a kernel must place exactly: each octave's
+// and segment's first input and either side of it, with the low bits clear and all set, those within [0, max].
+void append_octave_rom_ends(std::vector<std::int64_t>& out, int input_bits, int segments_log2, int shift,
+                            std::int64_t max) {
+  const std::int64_t segments = std::int64_t{1} << segments_log2;
+  for (int k = 0; k < input_bits; ++k) {
+    const std::int64_t start = std::int64_t{1} << k;
+    for (std::int64_t j = 0; j <= segments; ++j) {
+      const std::int64_t input = start + j * start / segments;
+      for (const std::int64_t c : {input - 1, input, input + 1}) {
+        for (const std::int64_t low : {std::int64_t{0}, (std::int64_t{1} << shift) - 1}) {
+          const std::int64_t v = (c << shift) + low;
+          if (v >= 0 && v <= max) out.push_back(v);
+        }
+      }
+    }
+  }
+}
+
+// The OLED drive code kernel (both lane widths: the 32-bit tables of DrivePlan and the 64-bit ones) against
+// FixedKernels::drive_code, value by value: every channel's thresholds and their neighbours, both sides of 2^24 (where
+// the 32-bit lanes' float conversion changes form), every octave, random values, and values outside [0, 1] (the
+// generic search), on every instruction set.
+// Both output depths: at 10 bits the index needs up to three steps (the base gather and three threshold gathers); at
+// 8 bits one, which takes the packed single gather (DrivePlan::packed32), and the stepped search of the same tables
+// beside it.
 TEST(FixedLines, OledDriveKernelGivesTheThresholdIndexCodes) {
   for (const int output_bits : {10, 8}) {
     const FixedDecoderConfig config = fixed_config(link_config(0.5), "vive", output_bits);
@@ -655,19 +674,7 @@ TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
     const int input_bits = std::bit_width(static_cast<std::uint64_t>(plan.top_code));
     // Values outside the kernel's lanes first and last, so that the vectors between keep their channel phase.
     std::vector<std::int64_t> values = {-1, one + 1, std::int64_t{1} << 40};
-    const std::int64_t segments = std::int64_t{1} << plan.segments_per_octave_log2;
-    for (int k = 0; k < input_bits; ++k) {
-      const std::int64_t start = std::int64_t{1} << k;
-      for (std::int64_t j = 0; j <= segments; ++j) {
-        const std::int64_t code = start + j * start / segments;
-        for (const std::int64_t c : {code - 1, code, code + 1}) {
-          for (const std::int64_t low : {std::int64_t{0}, (std::int64_t{1} << shift) - 1}) {
-            const std::int64_t v = (c << shift) + low;
-            if (v >= 0 && v <= one) values.push_back(v);
-          }
-        }
-      }
-    }
+    append_octave_rom_ends(values, input_bits, plan.segments_per_octave_log2, shift, one);
     std::mt19937_64 random(31);
     std::uniform_int_distribution<std::int64_t> linear(0, one);
     for (int i = 0; i < 20000; ++i) values.push_back(linear(random));
@@ -712,21 +719,8 @@ TEST(FixedLines, LcdTargetKernelGivesTheStageFunctionsTargets) {
     ASSERT_TRUE(kernels.line_plans().lcd.has_value());
     const fixed_detail::LcdPlan& plan = *kernels.line_plans().lcd;
     const std::int64_t two = 2 * kernels.one();
-    const int shift = plan.target_shift;
     std::vector<std::int64_t> sums = {-two, -1, 0, 1, two - 1, two, two + 1, std::int64_t{1} << 40};
-    const std::int64_t segments = std::int64_t{1} << plan.segments_per_octave_log2;
-    for (int k = 0; k < plan.target_input_bits; ++k) {
-      const std::int64_t start = std::int64_t{1} << k;
-      for (std::int64_t j = 0; j <= segments; ++j) {
-        const std::int64_t input = start + j * start / segments;
-        for (const std::int64_t c : {input - 1, input, input + 1}) {
-          for (const std::int64_t low : {std::int64_t{0}, (std::int64_t{1} << shift) - 1}) {
-            const std::int64_t sum = (c << shift) + low;
-            if (sum >= 0 && sum <= two) sums.push_back(sum);
-          }
-        }
-      }
-    }
+    append_octave_rom_ends(sums, plan.target_input_bits, plan.segments_per_octave_log2, plan.target_shift, two);
     std::mt19937_64 random(37);
     std::uniform_int_distribution<std::int64_t> in_range(0, two);
     for (int i = 0; i < 20000; ++i) sums.push_back(in_range(random));
