@@ -275,7 +275,7 @@ void FixedDecoderCore::reduced_line(FrameOutput& out, EyeState& eye, const Geome
   const bool previous_needed =
       (residual_row != nullptr || residual_zero) && (gate == nullptr || gate->reads_previous());
   // The line kernels: the per-pixel steps keep the shown values, whose drive codes are then found over the line (an
-  // LCD's one sample after the other, as emit takes them: a reduced frame passes on no shortfall).
+  // LCD's by its drive kernel or emit: a reduced frame passes on no shortfall).
   const bool whole_line = line_values(out);
   const std::optional<MotionPlan>& motion = kernels_.line_plans().motion;
   if (whole_line && motion && (residual_row != nullptr || residual_zero)) {
@@ -449,7 +449,7 @@ void FixedDecoderCore::drive_lcd_line(FrameOutput& out, EyeState& eye, int y, co
   std::array<std::uint8_t, kChunk> code_before;
   std::array<std::int32_t, kChunk> linear_before;
   std::array<Raw, kChunk> drive_raw;
-  std::array<std::uint16_t, kChunk> solved_against;  // v_{t-1} of each sample's merge (the held code on the first frame)
+  std::array<std::uint16_t, kChunk> solved_against;  // v_{t-1} of each merge (the held code on the first frame)
   for (std::size_t start = 0; start < samples; start += kChunk) {
     const std::size_t count = std::min(kChunk, samples - start);
     std::copy_n(previous_code + start, count, code_before.data());

@@ -1117,7 +1117,7 @@ void LcdSearch(const std::int64_t* target, const std::int64_t* rows, std::size_t
     hn::StoreU(hn::TruncateTo(d16, hn::BitCast(du, code)), d16, codes + s);
   }
 #endif
-  for (; s < n; ++s) {  // the search of FixedKernels::lcd_drive
+  for (; s < n; ++s) {  // the search of FixedKernels::lcd_drive (FixedKernels::lcd_search of the merge table's row)
     const std::int64_t* row = p.merge.data() + rows[s] * p.width;
     const int code = FixedKernels::merge_search(p.top, target[s] * static_cast<std::int64_t>(p.scale),
                                                 [row](int k) { return row[k]; });
@@ -1174,7 +1174,7 @@ void LcdTargets(const std::int64_t* sum, std::size_t n, const LcdPlan& p, const 
 }
 
 #if HWY_TARGET != HWY_SCALAR
-// a b mod 2^64 of 64-bit lanes for a below 2^32 (the products a b_low and a b_high by MulEven).
+// a b mod 2^64 of 64-bit lanes for 0 <= a < 2^32 (the products a b_low and a b_high by MulEven).
 template <class D>
 HWY_INLINE hn::Vec<D> MulNarrow(D d, hn::Vec<D> a, hn::Vec<D> b) {
   const hn::RebindToUnsigned<D> du;
@@ -1237,8 +1237,13 @@ void LcdDriveValues(const std::int64_t* sum, const std::int64_t* target, const s
       const auto denominator = MulNarrow(d, two_top, span);
       // The quotient within one of the estimate (fx::detail::rounded_quotient), settled by the remainder, which lies
       // in [-denominator, 2 denominator) and so is exact mod 2^64.
-      const auto estimate = hn::Add(
-          hn::Div(hn::Mul(hn::ConvertTo(df, part), drive_scale), hn::ConvertTo(df, denominator)), half);
+      // A flat merge's lanes (span <= 0, the stage function's below) estimate 0 / 1: no lane converts a NaN or a
+      // double beyond int64 back (undefined in the scalar emulation of the conversion).
+      const auto flat = hn::Not(hn::Gt(span, zero));
+      const auto estimate =
+          hn::Add(hn::Div(hn::Mul(hn::ConvertTo(df, hn::IfThenZeroElse(flat, part)), drive_scale),
+                          hn::ConvertTo(df, hn::IfThenElse(flat, one, denominator))),
+                  half);
       auto quotient = hn::ConvertTo(d, estimate);
       const auto rounded = hn::Add(hn::ShiftLeftSame(part, shift), hn::ShiftRight<1>(denominator));
       const auto remainder = hn::Sub(rounded, MulNarrow(d, quotient, denominator));
@@ -1247,7 +1252,7 @@ void LcdDriveValues(const std::int64_t* sum, const std::int64_t* target, const s
       const auto value = hn::IfThenElseZero(hn::Not(below), hn::IfThenElse(above, full_drive, quotient));
       hn::StoreU(value, d, drive + s);
       // A flat merge (quantised coefficients) takes the stage function, as its division by a zero span would.
-      if (!hn::AllFalse(d, hn::AndNot(hn::Or(below, above), hn::Not(hn::Gt(span, zero))))) {
+      if (!hn::AllFalse(d, hn::AndNot(hn::Or(below, above), flat))) {
         for (std::size_t k = s; k < s + lanes; ++k) {
           drive[k] = kernels.lcd_report_drive(sum[k], target[k], rows[k], codes[k]);
         }
@@ -2084,6 +2089,9 @@ std::optional<MotionPlan> motion_plan(const FixedKernels& kernels, const std::ar
 // coefficients.
 template <typename Merge>
 void lcd_report_table(LcdPlan& plan, Merge merge, int drive_frac_bits) {
+  // The quotient (at most 2^D + 1) a 32-bit operand of MulNarrow, and its estimate within 1 (FixedDecoderConfig
+  // bounds D to [8, 30]).
+  if (drive_frac_bits < 0 || drive_frac_bits > 30) return;
   const std::int64_t two_top = 2 * static_cast<std::int64_t>(plan.top);
   const std::int64_t words = plan.width + 1;
   std::vector<std::int64_t> table(static_cast<std::size_t>(plan.width * words));

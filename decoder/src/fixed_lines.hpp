@@ -269,7 +269,7 @@ struct LcdPlan {
   // lcd_drive_values: per v_{t-1} = j, report_row_words = 2^o + 1 words M(clamp(2c - 1, 0, 2 Mx), j) scaled as the
   // merge table, c = 0 .. 2^o (the thresholds either side of code c at c and c + 1). Built where every positive span
   // between them stays below 2^62 / (2 Mx + 2), and every word within (-2^61, 2^61), so that the interpolation's
-  // operands and its denominator fit 63 bits; empty otherwise.
+  // operands and its denominator fit 63 bits, and drive_frac_bits <= 30; empty otherwise.
   std::vector<std::int64_t> report_merge;
   std::int64_t report_row_words = 0;
   int drive_frac_bits = 0;

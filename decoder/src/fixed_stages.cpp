@@ -238,7 +238,7 @@ void FixedKernels::lcd_reports(const Linear* wanted, const std::int32_t* previou
   }
   // lcd_solve's steps, the code given, a chunk at a time: the targets by the target ROM's kernel, and on the eye's
   // first frame (x_{t-1} = x_t) v_{t-1} by the search of the merge table's held row (lcd_held_code).
-  constexpr std::size_t kChunk = 256;
+  constexpr std::size_t kChunk = 3 * 128;  // FixedDecoderCore::drive_lcd_line's chunk, whole
   std::array<Raw, kChunk> sums;
   std::array<Raw, kChunk> targets;
   std::array<Raw, kChunk> held_row;

@@ -704,11 +704,11 @@ TEST(FixedLines, OledDriveValueKernelGivesTheStageFunctionsValues) {
 
 // The LCD target kernel against the stage function: sums at every octave's and segment's ends of the target ROM's
 // input and either side (and the LSBs below the input), random sums, and sums at or below 0 and at or above 2 (the
-// clamped ends), on every instruction set; F = 20, 24 (two bits below the ROM's 24-bit input) and 28, and 1, 64 and
-// 512 segments an octave.
+// clamped ends), on every instruction set; F = 28 (the default, 512 segments an octave), 20 (64 segments) and 26 (one
+// segment an octave, three bits below the ROM's 24-bit input), and F = 28 with 2048 segments.
 TEST(FixedLines, LcdTargetKernelGivesTheStageFunctionsTargets) {
   std::vector<FixedDecoderConfig> configs = {fixed_config(link_config(0.5), "lcd")};
-  for (const auto& [frac_bits, segments] : {std::pair{20, 64}, std::pair{26, 1}, std::pair{28, 512}}) {
+  for (const auto& [frac_bits, segments] : {std::pair{20, 64}, std::pair{26, 1}, std::pair{28, 2048}}) {
     configs.push_back(configs[0]);
     configs.back().linear_frac_bits = frac_bits;
     configs.back().residual.frac_bits = frac_bits;

@@ -39,10 +39,22 @@ TEST(FastPath, RoundedQuotientIsTheDivisionsQuotient) {
   using detail::uint128;
   std::mt19937_64 rng(43);
   std::uint64_t checked = 0;
+  std::uint64_t estimates_high = 0;
+  std::uint64_t estimates_low = 0;
   const auto check = [&](uint128 part, int shift, uint128 denominator) {
     if (denominator == 0) return;
     const uint128 expected = ((part << shift) + denominator / 2) / denominator;
     if ((expected >> 64) != 0) return;
+    constexpr uint128 k64 = uint128{1} << 64;
+    if (part < k64 && denominator < k64 && shift <= 30 && (part >> (50 - shift)) < denominator) {
+      // The estimate rounded_quotient starts from, where it takes it: how often the products must settle it.
+      const double part_value = static_cast<double>(static_cast<std::uint64_t>(part));
+      const double denominator_value = static_cast<double>(static_cast<std::uint64_t>(denominator));
+      const auto estimate =
+          static_cast<std::uint64_t>(part_value * std::ldexp(1.0, shift) / denominator_value + 0.5);
+      estimates_high += estimate > expected ? 1 : 0;
+      estimates_low += estimate < expected ? 1 : 0;
+    }
     ASSERT_EQ(detail::rounded_quotient(part, shift, denominator), static_cast<std::uint64_t>(expected))
         << "part " << static_cast<std::uint64_t>(part) << " (high " << static_cast<std::uint64_t>(part >> 64)
         << ") shift " << shift << " denominator " << static_cast<std::uint64_t>(denominator) << " (high "
@@ -52,7 +64,8 @@ TEST(FastPath, RoundedQuotientIsTheDivisionsQuotient) {
   for (int shift = 0; shift <= 34; ++shift) {
     for (int i = 0; i < 4000; ++i) {
       // An odd denominator 2d + 1 and q + 1/2 = (part 2^shift + d) / (2d + 1) + 1/2: part 2^shift = q (2d + 1) + d
-      // + delta sits delta / (2d + 1) from the half (delta in [-2, 2]); part is its nearest multiple of 2^shift.
+      // + delta sits delta / (2d + 1) from the half (delta in [-2, 2]); part is its multiple of 2^shift at or below,
+      // and the next.
       const int denominator_bits = 1 + static_cast<int>(rng() % 63);
       const uint128 denominator = (rng() >> (64 - denominator_bits)) | 1;
       const int quotient_bits = static_cast<int>(rng() % 52);
@@ -82,6 +95,8 @@ TEST(FastPath, RoundedQuotientIsTheDivisionsQuotient) {
     }
   }
   EXPECT_GT(checked, 34u * 4000u * 10u);
+  EXPECT_GT(estimates_high, 100u) << "estimates above the quotient";
+  EXPECT_GT(estimates_low, 100u) << "estimates below the quotient";
 }
 
 // y0 + (y1 - y0) w / 2^bits rounded by the table's own mode, exactly (the definition interpolate implements).
